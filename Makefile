@@ -1,0 +1,54 @@
+# edgeslam front door. `make demo` and `make test` work on a fresh Debian 12 machine.
+SHELL := /bin/bash
+BUILD_DIR ?= build
+ASAN_DIR ?= build-asan
+BUILD_TYPE ?= Release
+WERROR ?= ON
+JOBS ?= $(shell nproc)
+EDGESLAM_SHARED ?= $(abspath $(CURDIR)/../shared)
+EDGESLAM_DATA ?= $(EDGESLAM_SHARED)/datasets/7scenes-redkitchen-1000
+DEMO_OUT ?= out/demo
+DEMO_ARGS ?=
+export EDGESLAM_SHARED
+
+.PHONY: all deps configure build test test-release test-sanitize demo bench format format-check clean
+
+all: build
+
+deps:
+	@bash scripts/deps.sh
+
+configure: deps
+	@cmake -S . -B $(BUILD_DIR) -G Ninja -DCMAKE_BUILD_TYPE=$(BUILD_TYPE) -DEDGESLAM_WERROR=$(WERROR) \
+	  -DEDGESLAM_SHARED_DIR=$(EDGESLAM_SHARED) > /dev/null
+
+build: configure
+	@cmake --build $(BUILD_DIR) -j $(JOBS)
+
+test-release: build
+	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) --timeout 900
+
+# The sanitizer build runs the fast unit tests only (label "unit"); CI runs it when CI is set.
+test-sanitize: deps
+	@cmake -S . -B $(ASAN_DIR) -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DEDGESLAM_WERROR=$(WERROR) \
+	  -DEDGESLAM_SANITIZE=ON -DEDGESLAM_SHARED_DIR=$(EDGESLAM_SHARED) > /dev/null
+	@cmake --build $(ASAN_DIR) -j $(JOBS)
+	@cd $(ASAN_DIR) && ctest --output-on-failure -j $(JOBS) -L unit --timeout 900
+
+test: test-release
+	@if [ -n "$$CI" ]; then $(MAKE) --no-print-directory test-sanitize; fi
+
+demo: build
+	@./$(BUILD_DIR)/edgeslam run --dataset "$(EDGESLAM_DATA)" --mode edge --out $(DEMO_OUT) $(DEMO_ARGS)
+
+bench: build
+	@bash bench/run.sh
+
+format:
+	@git ls-files '*.cpp' '*.h' | xargs clang-format -i
+
+format-check:
+	@git ls-files '*.cpp' '*.h' | xargs clang-format --dry-run --Werror
+
+clean:
+	rm -rf $(BUILD_DIR) $(ASAN_DIR)

@@ -1,0 +1,44 @@
+// `edgeslam`: one binary, one sub-command per job (run, eval, dataset, ...).
+#include <spdlog/spdlog.h>
+
+#include <CLI/CLI.hpp>
+#include <exception>
+#include <string>
+
+#include "commands.h"
+
+namespace edgeslam::cli {
+
+int& exitCode() {
+  static int code = 0;
+  return code;
+}
+
+}  // namespace edgeslam::cli
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "edgeslam: edge-assisted real-time semantic visual SLAM.\n"
+      "Run `edgeslam SUBCOMMAND --help` for the options of each sub-command."};
+  app.require_subcommand(1);
+  std::string log_level = "info";
+  app.add_option("--log-level", log_level, "trace|debug|info|warn|error|off")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error", "off"}));
+  app.set_version_flag("--version", std::string("edgeslam 0.1.0"));
+  app.parse_complete_callback([&] { spdlog::set_level(spdlog::level::from_str(log_level)); });
+  spdlog::set_pattern("[%H:%M:%S.%e] [%^%l%$] %v");
+
+  edgeslam::cli::addRunCommand(app);
+  edgeslam::cli::addEvalCommands(app);
+  edgeslam::cli::addDatasetCommands(app);
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const std::exception& e) {
+    spdlog::error("{}", e.what());
+    return 1;
+  }
+  return edgeslam::cli::exitCode();
+}
