@@ -1,5 +1,6 @@
 #pragma once
-// Each sub-command registers itself on the root app; the callback runs the command and sets the exit code.
+// Each sub-command registers itself on the root app; the callback runs the command and sets the
+// exit code.
 #include <CLI/CLI.hpp>
 
 namespace edgeslam::cli {

@@ -26,16 +26,17 @@ PinholeCamera::PinholeCamera(const CameraIntrinsics& in) : intrinsics_(in) {
   require(in.depth_factor >= 0.0, "depth_factor must not be negative");
   require(in.fps >= 0.0, "fps must not be negative");
   const Distortion& d = in.distortion;
-  require(std::isfinite(d.k1) && std::isfinite(d.k2) && std::isfinite(d.p1) && std::isfinite(d.p2) &&
-              std::isfinite(d.k3),
+  require(std::isfinite(d.k1) && std::isfinite(d.k2) && std::isfinite(d.p1) &&
+              std::isfinite(d.p2) && std::isfinite(d.k3),
           "distortion coefficients must be finite");
 
   const double w = in.width, h = in.height;
   bounds_ = {0.0, w, 0.0, h};
   if (hasDistortion()) {
-    const std::vector<cv::Point2f> corners = {
-        {0.f, 0.f}, {static_cast<float>(w), 0.f}, {0.f, static_cast<float>(h)},
-        {static_cast<float>(w), static_cast<float>(h)}};
+    const std::vector<cv::Point2f> corners = {{0.f, 0.f},
+                                              {static_cast<float>(w), 0.f},
+                                              {0.f, static_cast<float>(h)},
+                                              {static_cast<float>(w), static_cast<float>(h)}};
     const auto u = undistort(corners);
     bounds_.min_x = std::min(u[0].x, u[2].x);
     bounds_.max_x = std::max(u[1].x, u[3].x);

@@ -1,5 +1,6 @@
 #pragma once
-// Pinhole camera with radial-tangential (Brown-Conrady / OpenCV) distortion, optional stereo baseline.
+// Pinhole camera with radial-tangential (Brown-Conrady / OpenCV) distortion, optional stereo
+// baseline.
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 #include <optional>
@@ -41,7 +42,8 @@ class PinholeCamera {
   cv::Mat cvK() const;
   cv::Mat cvDistortion() const;
 
-  // Ideal (undistorted) pinhole projection of a point in the camera frame; nullopt behind the camera.
+  // Ideal (undistorted) pinhole projection of a point in the camera frame; nullopt behind the
+  // camera.
   std::optional<Eigen::Vector2d> project(const Eigen::Vector3d& point_camera) const;
   // Projection through the distortion model, i.e. where the point lands in the raw image.
   std::optional<Eigen::Vector2d> projectDistorted(const Eigen::Vector3d& point_camera) const;
@@ -53,7 +55,8 @@ class PinholeCamera {
   Eigen::Vector2d undistort(const Eigen::Vector2d& distorted_pixel) const;
   std::vector<cv::Point2f> undistort(const std::vector<cv::Point2f>& distorted_pixels) const;
 
-  // Bounds of the undistorted image (the corners mapped through undistort): where keypoints can land.
+  // Bounds of the undistorted image (the corners mapped through undistort): where keypoints can
+  // land.
   struct Bounds {
     double min_x, max_x, min_y, max_y;
   };

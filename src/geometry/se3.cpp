@@ -69,7 +69,9 @@ Eigen::Matrix4d SE3d::matrix() const {
   return m;
 }
 
-Eigen::Matrix<double, 3, 4> SE3d::matrix3x4() const { return matrix().topRows<3>(); }
+Eigen::Matrix<double, 3, 4> SE3d::matrix3x4() const {
+  return matrix().topRows<3>();
+}
 
 double rotationDistance(const SE3d& a, const SE3d& b) {
   return so3Log(a.rotation() * b.rotation().conjugate()).norm();

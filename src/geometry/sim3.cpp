@@ -19,7 +19,8 @@ Eigen::Matrix3d sim3TranslationJacobian(const Eigen::Vector3d& omega, double sig
   double c1 = 0.0;  // coefficient of [omega]x
   double c2 = 0.0;  // coefficient of [omega]x^2
   if (theta < 1e-8) {
-    // Limits of the coefficients as theta -> 0: integrals of tau e^(sigma tau) and tau^2/2 e^(sigma tau).
+    // Limits of the coefficients as theta -> 0: integrals of tau e^(sigma tau) and tau^2/2 e^(sigma
+    // tau).
     if (tiny_sigma) {
       c1 = 0.5;
       c2 = 1.0 / 6.0;

@@ -29,7 +29,8 @@ class Sim3d {
   const Eigen::Vector3d& translation() const { return translation_; }
 
   Sim3d operator*(const Sim3d& o) const {
-    return {scale_ * o.scale_, rotation_ * o.rotation_, scale_ * (rotation_ * o.translation_) + translation_};
+    return {scale_ * o.scale_, rotation_ * o.rotation_,
+            scale_ * (rotation_ * o.translation_) + translation_};
   }
   Eigen::Vector3d operator*(const Eigen::Vector3d& p) const {
     return scale_ * (rotation_ * p) + translation_;

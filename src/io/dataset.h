@@ -20,13 +20,13 @@ std::string toString(DatasetFormat format);
 DatasetFormat parseDatasetFormat(const std::string& name);
 
 struct DatasetFrame {
-  std::size_t index = 0;   // position in the sequence, 0-based
-  double timestamp = 0.0;  // seconds
-  std::string name;        // file name (or frame number) for messages
-  cv::Mat gray;            // CV_8UC1, always present
-  cv::Mat color;           // CV_8UC3 BGR, empty when the dataset is grey only
-  cv::Mat depth;           // CV_32FC1 metres, 0 where invalid; empty when no depth
-  cv::Mat right_gray;      // CV_8UC1 right stereo image; empty when not stereo
+  std::size_t index = 0;             // position in the sequence, 0-based
+  double timestamp = 0.0;            // seconds
+  std::string name;                  // file name (or frame number) for messages
+  cv::Mat gray;                      // CV_8UC1, always present
+  cv::Mat color;                     // CV_8UC3 BGR, empty when the dataset is grey only
+  cv::Mat depth;                     // CV_32FC1 metres, 0 where invalid; empty when no depth
+  cv::Mat right_gray;                // CV_8UC1 right stereo image; empty when not stereo
   std::optional<SE3d> ground_truth;  // camera-to-world, when the dataset has it for this frame
 };
 

@@ -83,8 +83,8 @@ void writeTumTrajectory(const std::filesystem::path& path, const Trajectory& tra
   for (const auto& [timestamp, pose] : trajectory) {
     const Eigen::Vector3d& t = pose.translation();
     const Eigen::Quaterniond& q = pose.rotation();
-    out << fmt::format("{:.6f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f}\n", timestamp, t.x(),
-                       t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
+    out << fmt::format("{:.6f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f} {:.9f}\n", timestamp,
+                       t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
   }
   if (!out) throw DatasetError(fmt::format("failed writing {}", path.string()));
 }

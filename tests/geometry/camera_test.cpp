@@ -64,7 +64,8 @@ TEST(PinholeCamera, UndistortMatchesOpenCvProjection) {
   ASSERT_TRUE(raw.has_value());
   std::vector<cv::Point3d> obj{{p.x(), p.y(), p.z()}};
   std::vector<cv::Point2d> img;
-  cv::projectPoints(obj, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), cam.cvK(), cam.cvDistortion(), img);
+  cv::projectPoints(obj, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), cam.cvK(), cam.cvDistortion(),
+                    img);
   EXPECT_NEAR(raw->x(), img[0].x, 1e-9);
   EXPECT_NEAR(raw->y(), img[0].y, 1e-9);
   EXPECT_LT((cam.undistort(*raw) - *cam.project(p)).norm(), 1e-3);

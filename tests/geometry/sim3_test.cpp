@@ -20,8 +20,8 @@ Eigen::Vector3d integratedTranslation(const Vector7d& xi) {
   for (int i = 0; i <= n; ++i) {
     const double t = static_cast<double>(i) / n;
     const double w = (i == 0 || i == n) ? 1.0 : (i % 2 == 1 ? 4.0 : 2.0);
-    sum += w * std::exp(xi(6) * t) * (so3Exp(t * Eigen::Vector3d(xi.segment<3>(3))) *
-                                      Eigen::Vector3d(xi.head<3>()));
+    sum += w * std::exp(xi(6) * t) *
+           (so3Exp(t * Eigen::Vector3d(xi.segment<3>(3))) * Eigen::Vector3d(xi.head<3>()));
   }
   return sum / (3.0 * n);
 }

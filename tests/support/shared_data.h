@@ -1,5 +1,6 @@
 #pragma once
-// Locates the shared real data (../shared) for tests; EDGESLAM_SHARED overrides the built-in default.
+// Locates the shared real data (../shared) for tests; EDGESLAM_SHARED overrides the built-in
+// default.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -15,9 +16,13 @@ inline std::filesystem::path sharedDir() {
   return EDGESLAM_DEFAULT_SHARED_DIR;
 }
 
-inline std::filesystem::path sharedPath(const std::string& relative) { return sharedDir() / relative; }
+inline std::filesystem::path sharedPath(const std::string& relative) {
+  return sharedDir() / relative;
+}
 
-inline std::filesystem::path edgeslamBinary() { return EDGESLAM_BINARY_PATH; }
+inline std::filesystem::path edgeslamBinary() {
+  return EDGESLAM_BINARY_PATH;
+}
 
 }  // namespace edgeslam::test
 
