@@ -1,9 +1,211 @@
+// `edgeslam run`: the whole pipeline (client and edge) in one command.
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <filesystem>
+#include <optional>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <thread>
+
 #include "commands.h"
+#include "io/camera_file.h"
+#include "eval/ate.h"
+#include "io/dataset.h"
+#include "io/trajectory.h"
+#include "pipeline/local_slam.h"
+#include "progress_line.h"
+#include "run_options.h"
+#include "util/timing_stats.h"
 
 namespace edgeslam::cli {
+namespace {
+
+nlohmann::json toJson(const PercentileSummary& s) {
+  return {{"median", s.median}, {"p90", s.p90}, {"p99", s.p99}, {"max", s.max}};
+}
+
+std::string resolveSensor(const std::string& requested, const DatasetInfo& info) {
+  if (requested == "auto") return info.has_depth ? "rgbd" : "mono";
+  if (requested == "rgbd" && !info.has_depth) {
+    throw std::invalid_argument("--sensor rgbd needs depth images, and " + info.path.string() +
+                                " has none");
+  }
+  if (requested == "stereo" && !info.has_stereo) {
+    throw std::invalid_argument("--sensor stereo needs right images, and " + info.path.string() +
+                                " has none");
+  }
+  return requested;
+}
+
+std::optional<nlohmann::json> ateJson(const Trajectory& gt, const Trajectory& est,
+                                      AlignMode align) {
+  if (gt.empty() || est.size() < 3) return std::nullopt;
+  const PosePairs pairs = associateByTimestamp(gt, est);
+  if (pairs.size() < minimumPairsForAlignment(align)) return std::nullopt;
+  const AteResult ate = computeAte(pairs, align);
+  return nlohmann::json{{"rmse_m", ate.translation.rmse},
+                        {"mean_m", ate.translation.mean},
+                        {"median_m", ate.translation.median},
+                        {"max_m", ate.translation.max},
+                        {"pairs", ate.translation.count},
+                        {"scale", ate.alignment.scale()},
+                        {"align", toString(align)}};
+}
+
+Sensor toSensor(const std::string& name) {
+  if (name == "rgbd") return Sensor::kRgbd;
+  if (name == "stereo") return Sensor::kStereo;
+  return Sensor::kMonocular;
+}
+
+int runPipeline(const RunOptions& options) {
+  DatasetOptions dataset_options;
+  dataset_options.format = parseDatasetFormat(options.format);
+  if (options.camera_file) dataset_options.camera_override = loadCameraFile(*options.camera_file);
+  auto reader = openDataset(options.dataset, dataset_options);
+  const DatasetInfo& info = reader->info();
+  const std::string sensor_name = resolveSensor(options.sensor, info);
+  if (sensor_name == "stereo") {
+    throw std::invalid_argument("--sensor stereo is not supported yet; use mono or rgbd");
+  }
+  const Sensor sensor = toSensor(sensor_name);
+  const std::size_t frame_count =
+      options.max_frames > 0 ? std::min(options.max_frames, info.frame_count) : info.frame_count;
+  spdlog::info("dataset {} ({}, {} frames, {} fps), camera {}", info.path.string(),
+               toString(info.format), info.frame_count, info.fps, reader->camera().describe());
+  std::string mode = options.mode;
+  if (mode != "local") {
+    spdlog::warn("--mode {} is not built yet: running the same SLAM in one process (local mode)",
+                 mode);
+    mode = "local";
+  }
+
+  LocalSlam slam(reader->camera(), defaultLocalSlamOptions(reader->camera(), sensor));
+  SampleStats client_ms, load_ms;
+  ProgressLine progress;
+  Stopwatch wall;
+  Trajectory ground_truth;
+  std::size_t tracked = 0, lost = 0;
+  const auto& stamps = reader->timestamps();
+  for (std::size_t i = 0; i < frame_count; ++i) {
+    if (options.realtime && i > 0) {
+      const double due_ms = (stamps[i] - stamps[0]) * 1000.0;
+      const double wait_ms = due_ms - wall.elapsedMs();
+      if (wait_ms > 0) std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(wait_ms));
+    }
+    Stopwatch load_timer;
+    const DatasetFrame frame = reader->load(i);
+    load_ms.add(load_timer.elapsedMs());
+    if (frame.ground_truth) ground_truth.push_back({frame.timestamp, *frame.ground_truth});
+    Stopwatch frame_timer;
+    const TrackResult result = slam.process(i, frame.timestamp, frame.gray, frame.depth);
+    client_ms.add(frame_timer.elapsedMs());
+    if (result.state == TrackingState::kOk) {
+      ++tracked;
+    } else if (result.state == TrackingState::kLost) {
+      ++lost;
+    }
+    const double fps = static_cast<double>(i + 1) / std::max(1e-9, wall.elapsedMs() / 1000.0);
+    progress.update(fmt::format("frame {}/{}  {:.1f} fps  {}  tracked {}  kf {}  points {}", i + 1,
+                                frame_count, fps, toString(result.state), tracked,
+                                slam.keyFrameCount(), slam.mapPointCount()),
+                    i + 1 == frame_count);
+  }
+  progress.finish();
+  slam.finish();
+  const double seconds = wall.elapsedMs() / 1000.0;
+  const PercentileSummary client = client_ms.summary();
+
+  const Trajectory at_time = slam.trajectoryAtFrameTime();
+  const Trajectory final_traj = slam.trajectoryFinal();
+  const AlignMode align = sensor == Sensor::kMonocular ? AlignMode::kSim3 : AlignMode::kSe3;
+  const auto ate = ateJson(ground_truth, at_time, align);
+  const auto ate_final = ateJson(ground_truth, final_traj, align);
+
+  const PercentileSummary zero;
+  nlohmann::json metrics = {{"frames", frame_count},
+                            {"tracked", tracked},
+                            {"lost", lost},
+                            {"keyframes", slam.keyFrameCount()},
+                            {"map_points", slam.mapPointCount()},
+                            {"client_ms", toJson(client)},
+                            {"e2e_ms", toJson(client)},
+                            {"uplink_bytes", 0},
+                            {"downlink_bytes", 0},
+                            {"bytes_per_keyframe", 0},
+                            {"slice_latency_ms", toJson(zero)},
+                            {"segmentation_ms", toJson(zero)},
+                            {"loops", 0},
+                            {"relocalizations", slam.tracker().relocalizations()},
+                            {"map_resets", slam.tracker().resets()},
+                            {"mode", mode},
+                            {"requested_mode", options.mode},
+                            {"sensor", sensor_name},
+                            {"dataset", info.path.string()},
+                            {"wall_s", seconds},
+                            {"load_ms", toJson(load_ms.summary())}};
+  if (ate) metrics["ate"] = *ate;
+  if (ate_final) metrics["ate_final"] = *ate_final;
+
+  fmt::print("\nSummary\n");
+  fmt::print("  dataset      {} ({})\n", info.path.string(), toString(info.format));
+  fmt::print("  mode/sensor  {} / {}\n", mode, sensor_name);
+  fmt::print("  frames       {} in {:.2f} s ({:.1f} fps), tracked {}, lost {}\n", frame_count,
+             seconds, static_cast<double>(frame_count) / std::max(seconds, 1e-9), tracked, lost);
+  fmt::print("  map          {} keyframes, {} points, {} relocalisations, {} resets\n",
+             slam.keyFrameCount(), slam.mapPointCount(), slam.tracker().relocalizations(),
+             slam.tracker().resets());
+  fmt::print("  client ms    median {:.2f}  p90 {:.2f}  p99 {:.2f}  max {:.2f}\n", client.median,
+             client.p90, client.p99, client.max);
+  if (ate) {
+    fmt::print("  ATE ({})    rmse {:.4f} m  ({} poses, at frame time)\n", toString(align),
+               (*ate)["rmse_m"].get<double>(), (*ate)["pairs"].get<std::size_t>());
+  }
+  if (ate_final) {
+    fmt::print("  ATE final    rmse {:.4f} m  ({} poses, refined)\n",
+               (*ate_final)["rmse_m"].get<double>(), (*ate_final)["pairs"].get<std::size_t>());
+  }
+
+  if (!options.out_dir.empty()) {
+    std::filesystem::create_directories(options.out_dir);
+    writeTumTrajectory(options.out_dir / "trajectory.tum", at_time);
+    writeTumTrajectory(options.out_dir / "trajectory_final.tum", final_traj);
+    writeTumTrajectory(options.out_dir / "keyframes.tum", slam.keyframeTrajectory());
+    std::ofstream out(options.out_dir / "metrics.json");
+    out << metrics.dump(2) << "\n";
+    spdlog::info("wrote trajectories and metrics.json to {}", options.out_dir.string());
+  }
+  return 0;
+}
+
+}  // namespace
 
 void addRunCommand(CLI::App& app) {
-  app.add_subcommand("run", "Run SLAM on a dataset (client and edge in one command)");
+  auto options = std::make_shared<RunOptions>();
+  auto* run = app.add_subcommand("run", "Run SLAM on a dataset (client and edge in one command)");
+  run->add_option("--dataset", options->dataset, "Dataset folder (or video file)")->required();
+  run->add_option("--format", options->format, "Dataset format")
+      ->check(CLI::IsMember({"auto", "tum", "kitti", "euroc", "7scenes", "images", "video"}));
+  run->add_option("--sensor", options->sensor, "Sensor; auto = rgbd when the dataset has depth")
+      ->check(CLI::IsMember({"auto", "mono", "rgbd", "stereo"}));
+  run->add_option("--mode", options->mode, "edge (edgeSLAM), local (ORB-SLAM), offload (Mask-SLAM)")
+      ->check(CLI::IsMember({"edge", "local", "offload"}));
+  run->add_option("--link", options->link, "Emulated link profile between client and edge");
+  run->add_option("--adapt", options->adapt, "Self-adaptation on|off")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, bool>{{"on", true}, {"off", false}}));
+  run->add_option("--semantic", options->semantic, "Semantic culling on|off")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, bool>{{"on", true}, {"off", false}}));
+  run->add_option("--max-frames", options->max_frames, "Process at most N frames (0 = all)");
+  auto* realtime = run->add_flag("--realtime", options->realtime,
+                                 "Feed frames at the dataset's rate, dropping none");
+  run->add_flag("--fast", options->fast, "Feed frames as fast as possible (the default)")
+      ->excludes(realtime);
+  run->add_option("--out", options->out_dir, "Output folder (trajectories, metrics.json)");
+  run->add_option("--viewer", options->viewer_port, "Serve the web viewer on this port");
+  run->add_option("--camera", options->camera_file, "Camera YAML overriding the dataset's camera")
+      ->check(CLI::ExistingFile);
+  run->callback([options] { exitCode() = runPipeline(*options); });
 }
 
 }  // namespace edgeslam::cli

@@ -1,0 +1,26 @@
+#pragma once
+// Options of `edgeslam run` (and later `client`), parsed from the command line.
+#include <cstddef>
+#include <filesystem>
+#include <optional>
+#include <string>
+
+namespace edgeslam::cli {
+
+struct RunOptions {
+  std::filesystem::path dataset;
+  std::string format = "auto";
+  std::string sensor = "auto";  // mono|rgbd|stereo; auto = rgbd when the dataset has depth
+  std::string mode = "edge";    // edge|local|offload
+  std::string link = "none";
+  bool adapt = true;
+  bool semantic = false;
+  std::size_t max_frames = 0;  // 0 = all
+  bool realtime = false;       // feed at the dataset's rate (default: as fast as possible)
+  bool fast = false;           // explicit request for the default
+  std::filesystem::path out_dir;
+  int viewer_port = 0;
+  std::optional<std::filesystem::path> camera_file;
+};
+
+}  // namespace edgeslam::cli

@@ -1,0 +1,31 @@
+#include "client/keyframe_policy.h"
+
+namespace edgeslam {
+
+KeyFrameDecision decideKeyFrame(const KeyFrameParameters& params, const KeyFrameEvidence& e) {
+  if (e.frame_tracked < static_cast<std::size_t>(params.min_tracked)) return KeyFrameDecision::kNo;
+
+  const bool enough_features =
+      e.reference_features == 0 ||
+      static_cast<double>(e.frame_features) >= params.alpha * static_cast<double>(e.reference_features);
+  if (!enough_features) return KeyFrameDecision::kNo;
+
+  const double tracked_ratio =
+      e.reference_tracked == 0
+          ? 0.0
+          : static_cast<double>(e.frame_tracked) / static_cast<double>(e.reference_tracked);
+  const bool starving = tracked_ratio < params.starving_ratio;
+  if (starving && e.mapper_accepts) return KeyFrameDecision::kYesStarving;
+
+  if (e.frames_since_map_update >= static_cast<std::size_t>(params.fmax) ||
+      e.frames_since_keyframe >= static_cast<std::size_t>(params.fmax)) {
+    return KeyFrameDecision::kYesForced;
+  }
+  const bool rule1 = e.frames_since_keyframe > static_cast<std::size_t>(params.fmin) ||
+                     e.keyframes_in_map < static_cast<std::size_t>(params.fmin);
+  const bool rule4 = tracked_ratio < params.beta;
+  if (rule1 && rule4 && e.mapper_accepts) return KeyFrameDecision::kYes;
+  return KeyFrameDecision::kNo;
+}
+
+}  // namespace edgeslam

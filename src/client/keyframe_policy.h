@@ -1,0 +1,45 @@
+#pragma once
+// When a tracked frame becomes a keyframe: the paper's four rules (Sec. V) with the parameters of
+// Table I (fmin, fmax, alpha, beta), plus a guard against starving tracking.
+//
+// The paper's rules, as implemented:
+//  (1) more than fmin frames since the last keyframe, or fewer than fmin keyframes in the map;
+//  (2) fewer than fmax frames since the last local-map optimisation (the edge's or the local mapper's
+//      latest update); past fmax a keyframe is forced so the map keeps up with the camera;
+//  (3) the frame has at least alpha times the reference keyframe's feature count (a good image);
+//  (4) the frame's tracked points are fewer than beta times the reference keyframe's tracked points
+//      (the view has changed).
+// A frame is a keyframe when (3) holds and either (1) and (4) hold, or (2) is violated.
+// Guard (why: with fmin = 10-40 frames, fast motion would lose tracking before the next keyframe is
+// allowed): when the tracked ratio falls below `starving_ratio`, rule (1) is waived.
+#include <cstddef>
+
+namespace edgeslam {
+
+struct KeyFrameParameters {
+  int fmin = 20;
+  int fmax = 60;
+  double alpha = 0.4;
+  double beta = 0.9;
+  double starving_ratio = 0.35;
+  int min_tracked = 15;  // never a keyframe from a frame that barely tracks
+};
+
+struct KeyFrameEvidence {
+  std::size_t frames_since_keyframe = 0;
+  std::size_t frames_since_map_update = 0;
+  std::size_t keyframes_in_map = 0;
+  std::size_t frame_features = 0;
+  std::size_t reference_features = 0;
+  std::size_t frame_tracked = 0;      // inlier matches to map points in this frame
+  std::size_t reference_tracked = 0;  // points of the reference keyframe seen by >= 2 keyframes
+  bool mapper_accepts = true;         // false while the mapper is too busy to take one
+};
+
+enum class KeyFrameDecision { kNo, kYes, kYesForced, kYesStarving };
+
+KeyFrameDecision decideKeyFrame(const KeyFrameParameters& params, const KeyFrameEvidence& evidence);
+
+inline bool isKeyFrame(KeyFrameDecision d) { return d != KeyFrameDecision::kNo; }
+
+}  // namespace edgeslam

@@ -1,0 +1,469 @@
+#include "client/tracker.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <unordered_map>
+
+#include "geometry/pnp.h"
+#include "map/map_matching.h"
+#include "optimize/map_optimization.h"
+
+namespace edgeslam {
+
+const char* toString(TrackingState state) {
+  switch (state) {
+    case TrackingState::kNotInitialized: return "not initialised";
+    case TrackingState::kOk: return "ok";
+    case TrackingState::kLost: return "lost";
+  }
+  return "?";
+}
+
+Tracker::Tracker(Map& map, const PinholeCamera& camera, TrackerOptions options, KeyFrameSink* sink)
+    : map_(map),
+      camera_(camera),
+      options_(std::move(options)),
+      sink_(sink),
+      mono_init_(camera, options_.monocular_init) {}
+
+TrackResult Tracker::track(std::size_t frame_index, double timestamp,
+                           std::shared_ptr<const FrameFeatures> features) {
+  Frame frame(frame_index, timestamp, std::move(features), &camera_);
+  TrackResult result;
+
+  if (state_ == TrackingState::kNotInitialized) {
+    if (initialize(frame)) {
+      state_ = TrackingState::kOk;
+      result.new_keyframe = true;
+      last_frame_ = frame;
+      record(frame, true);
+      result.state = state_;
+      result.T_cw = frame.T_cw;
+      result.tracked_points = frame.matchedCount();
+    } else {
+      record(frame, false);
+      result.state = state_;
+    }
+    return result;
+  }
+
+  KeyFrame* new_keyframe = nullptr;
+  bool ok = false;
+  {
+    std::lock_guard lock(map_.updateMutex());
+    if (last_frame_ && last_frame_->T_cw) {
+      // The last frame's keyframe may have moved since (local BA): follow it.
+      const FrameRecord& last_record = records_.back();
+      if (last_record.tracked && last_record.reference != nullptr &&
+          !last_record.reference->isBad()) {
+        last_frame_->T_cw = last_record.T_cr * last_record.reference->pose();
+      }
+    }
+    if (state_ == TrackingState::kOk) {
+      ok = velocity_ && trackWithMotionModel(frame);
+      if (!ok) ok = trackReferenceKeyFrame(frame);
+    } else {
+      ok = relocalize(frame);
+      if (ok) {
+        result.relocalized = true;
+        ++relocalizations_;
+        last_relocalization_frame_ = frame_index;
+        spdlog::info("relocalised at frame {}", frame_index);
+      }
+    }
+    frame.reference_keyframe = reference_keyframe_;
+
+    int inliers = 0;
+    if (ok) {
+      inliers = trackLocalMap(frame);
+      const bool recently_relocalized =
+          relocalizations_ > 0 && frame_index < last_relocalization_frame_ + 30;
+      ok = inliers >= (recently_relocalized ? options_.min_inliers_local_map_after_relocalization
+                                            : options_.min_inliers_local_map);
+    }
+
+    if (ok) {
+      if (state_ != TrackingState::kOk) frames_lost_ = 0;
+      state_ = TrackingState::kOk;
+      if (last_frame_ && last_frame_->T_cw) {
+        velocity_ = *frame.T_cw * last_frame_->T_cw->inverse();
+      }
+      if (isKeyFrame(decide(frame, inliers))) new_keyframe = createKeyFrame(frame);
+      result.tracked_points = inliers;
+    } else {
+      if (state_ == TrackingState::kOk) spdlog::warn("tracking lost at frame {}", frame_index);
+      state_ = TrackingState::kLost;
+      velocity_.reset();
+      ++frames_lost_;
+    }
+    for (std::size_t i = 0; i < frame.size(); ++i) {
+      if (frame.outliers[i]) {
+        frame.points[i] = nullptr;
+        frame.outliers[i] = false;
+      }
+    }
+  }
+
+  if (new_keyframe != nullptr && sink_ != nullptr) sink_->insertKeyFrame(new_keyframe);
+
+  // A monocular map that is lost within its first few keyframes is not worth keeping.
+  if (state_ == TrackingState::kLost && options_.sensor == Sensor::kMonocular && frames_lost_ > 0) {
+    std::size_t keyframes = 0;
+    {
+      std::lock_guard lock(map_.updateMutex());
+      keyframes = map_.keyFrameCount();
+    }
+    if (keyframes <= 5) {
+      spdlog::warn("map lost with only {} keyframes: starting a new one", keyframes);
+      if (sink_ != nullptr) sink_->onMapReset();
+      resetMap();
+      record(frame, false);
+      result.state = state_;
+      return result;
+    }
+  }
+
+  if (ok) last_frame_ = frame;
+  record(frame, ok);
+  result.state = state_;
+  if (ok) result.T_cw = frame.T_cw;
+  result.new_keyframe = new_keyframe != nullptr;
+  return result;
+}
+
+bool Tracker::initialize(Frame& frame) {
+  if (options_.sensor != Sensor::kMonocular) return initializeRgbd(frame);
+  KeyFrame* kf = mono_init_.tryInitialize(frame, map_);
+  if (kf == nullptr) return false;
+  std::lock_guard lock(map_.updateMutex());
+  KeyFrame* kf0 = map_.originKeyFrame();
+  spdlog::info("monocular map initialised at frame {} with {} points (reference frame {})",
+               frame.index, map_.pointCount(), kf0->frameIndex());
+  reference_keyframe_ = kf;
+  last_keyframe_ = kf;
+  last_keyframe_frame_ = frame.index;
+  frame.reference_keyframe = kf;
+  // The reference frame's own record gets its pose now that the map exists.
+  for (FrameRecord& r : records_) {
+    if (r.index == kf0->frameIndex()) {
+      r.tracked = true;
+      r.reference = kf0;
+      r.T_cr = SE3d();
+      r.T_cw = SE3d();
+    }
+  }
+  if (sink_ != nullptr) {
+    sink_->insertKeyFrame(kf0);
+    sink_->insertKeyFrame(kf);
+  }
+  return true;
+}
+
+bool Tracker::initializeRgbd(Frame& frame) {
+  if (frame.size() < static_cast<std::size_t>(options_.rgbd_init_min_features)) return false;
+  KeyFrame* kf = nullptr;
+  {
+    std::lock_guard lock(map_.updateMutex());
+    frame.T_cw = SE3d();
+    kf = map_.createKeyFrame(frame.index, frame.timestamp, frame.features, SE3d());
+    const FrameFeatures& f = *frame.features;
+    for (std::size_t i = 0; i < frame.size(); ++i) {
+      if (!f.hasDepth(i)) continue;
+      const cv::Point2f& pt = f.keypoints[i].pt;
+      const Eigen::Vector3d x = camera_.unproject({pt.x, pt.y}) * f.depth[i];
+      MapPoint* p = map_.createMapPoint(x, kf);
+      map_.addObservation(p, kf, i);
+      map_.refreshPoint(p);
+      frame.points[i] = p;
+    }
+    if (map_.pointCount() < 100) {
+      map_.clear();
+      frame.T_cw.reset();
+      std::fill(frame.points.begin(), frame.points.end(), nullptr);
+      return false;
+    }
+    spdlog::info("RGB-D map initialised at frame {} with {} points", frame.index,
+                 map_.pointCount());
+  }
+  reference_keyframe_ = kf;
+  last_keyframe_ = kf;
+  last_keyframe_frame_ = frame.index;
+  frame.reference_keyframe = kf;
+  if (sink_ != nullptr) sink_->insertKeyFrame(kf);
+  return true;
+}
+
+int Tracker::discardOutliers(Frame& frame) {
+  int inliers = 0;
+  for (std::size_t i = 0; i < frame.size(); ++i) {
+    if (frame.points[i] == nullptr) continue;
+    if (frame.outliers[i]) {
+      frame.points[i]->track_in_view = false;
+      frame.points[i]->last_frame_seen = frame.index;
+      frame.points[i] = nullptr;
+      frame.outliers[i] = false;
+    } else if (frame.points[i]->observationCount() > 0) {
+      ++inliers;
+    }
+  }
+  return inliers;
+}
+
+bool Tracker::trackWithMotionModel(Frame& frame) {
+  const Frame& last = *last_frame_;
+  frame.T_cw = *velocity_ * *last.T_cw;
+  const bool mono = options_.sensor == Sensor::kMonocular;
+  const float radius = mono ? 15.f : 7.f;
+  std::fill(frame.points.begin(), frame.points.end(), nullptr);
+  int matches = matchByProjection(frame, last, radius, mono);
+  if (matches < 20) {
+    std::fill(frame.points.begin(), frame.points.end(), nullptr);
+    matches = matchByProjection(frame, last, 2.f * radius, mono);
+  }
+  if (matches < 20) return false;
+  optimizeFramePose(frame);
+  return discardOutliers(frame) >= options_.min_inliers_motion;
+}
+
+bool Tracker::trackReferenceKeyFrame(Frame& frame) {
+  if (reference_keyframe_ == nullptr || reference_keyframe_->isBad() || !last_frame_) return false;
+  std::fill(frame.points.begin(), frame.points.end(), nullptr);
+  const int matches = matchKeyFrameByDescriptor(*reference_keyframe_, frame);
+  if (matches < 15) return false;
+  frame.T_cw = last_frame_->T_cw ? *last_frame_->T_cw : reference_keyframe_->pose();
+  optimizeFramePose(frame);
+  return discardOutliers(frame) >= options_.min_inliers_motion;
+}
+
+bool Tracker::relocalize(Frame& frame) {
+  // Without a place-recognition database yet, try the most recent keyframes and the last reference's
+  // neighbourhood.
+  std::vector<KeyFrame*> candidates;
+  const std::vector<KeyFrame*> all = map_.keyFrames();
+  for (auto it = all.rbegin(); it != all.rend() && candidates.size() < 15; ++it) {
+    candidates.push_back(*it);
+  }
+  if (reference_keyframe_ != nullptr && !reference_keyframe_->isBad()) {
+    for (KeyFrame* kf : reference_keyframe_->bestCovisibles(10)) {
+      if (std::find(candidates.begin(), candidates.end(), kf) == candidates.end()) {
+        candidates.push_back(kf);
+      }
+    }
+  }
+  for (KeyFrame* kf : candidates) {
+    std::fill(frame.points.begin(), frame.points.end(), nullptr);
+    std::fill(frame.outliers.begin(), frame.outliers.end(), false);
+    if (matchKeyFrameByDescriptor(*kf, frame, 0.75f) < 15) continue;
+    std::vector<Eigen::Vector2d> pixels;
+    std::vector<Eigen::Vector3d> points;
+    std::vector<std::size_t> index;
+    for (std::size_t i = 0; i < frame.size(); ++i) {
+      if (frame.points[i] == nullptr) continue;
+      const cv::Point2f& pt = frame.features->keypoints[i].pt;
+      pixels.emplace_back(pt.x, pt.y);
+      points.push_back(frame.points[i]->position());
+      index.push_back(i);
+    }
+    const PnpResult pnp = solvePnpRansac(pixels, points, camera_.K());
+    if (!pnp.success) continue;
+    for (std::size_t k = 0; k < index.size(); ++k) {
+      if (!pnp.inliers[k]) frame.points[index[k]] = nullptr;
+    }
+    frame.T_cw = pnp.camera_from_world;
+    optimizeFramePose(frame);
+    int inliers = discardOutliers(frame);
+    if (inliers < 50) {
+      std::vector<MapPoint*> found;
+      for (MapPoint* p : frame.points) {
+        if (p != nullptr) found.push_back(p);
+      }
+      matchKeyFrameByProjection(frame, *kf, found, 10.f, 100);
+      optimizeFramePose(frame);
+      inliers = discardOutliers(frame);
+    }
+    if (inliers >= 50) {
+      reference_keyframe_ = kf;
+      return true;
+    }
+  }
+  std::fill(frame.points.begin(), frame.points.end(), nullptr);
+  frame.T_cw.reset();
+  return false;
+}
+
+void Tracker::updateLocalMap(const Frame& frame) {
+  // Keyframes that see the frame's points, weighted by how many.
+  std::unordered_map<KeyFrame*, int> counter;
+  for (std::size_t i = 0; i < frame.size(); ++i) {
+    MapPoint* p = frame.points[i];
+    if (p == nullptr || p->isBad()) continue;
+    for (const auto& [id, obs] : p->observations()) ++counter[obs.keyframe];
+  }
+  local_keyframes_.clear();
+  KeyFrame* best = nullptr;
+  int best_count = 0;
+  for (const auto& [kf, count] : counter) {
+    if (kf->isBad()) continue;
+    if (count > best_count) {
+      best_count = count;
+      best = kf;
+    }
+    local_keyframes_.push_back(kf);
+    kf->track_reference_for_frame = frame.index;
+  }
+  std::sort(local_keyframes_.begin(), local_keyframes_.end(), KeyFrameIdLess{});
+  const std::size_t direct = local_keyframes_.size();
+  for (std::size_t k = 0; k < direct && local_keyframes_.size() < options_.max_local_keyframes;
+       ++k) {
+    KeyFrame* kf = local_keyframes_[k];
+    auto consider = [&](KeyFrame* other) {
+      if (other == nullptr || other->isBad() || other->track_reference_for_frame == frame.index) {
+        return false;
+      }
+      other->track_reference_for_frame = frame.index;
+      local_keyframes_.push_back(other);
+      return true;
+    };
+    for (KeyFrame* n : kf->bestCovisibles(10)) {
+      if (consider(n)) break;
+    }
+    for (KeyFrame* c : kf->children()) {
+      if (consider(c)) break;
+    }
+    consider(kf->parent());
+  }
+  if (best != nullptr) reference_keyframe_ = best;
+
+  local_points_.clear();
+  for (KeyFrame* kf : local_keyframes_) {
+    for (MapPoint* p : kf->points()) {
+      if (p == nullptr || p->isBad() || p->track_reference_frame == frame.index) continue;
+      p->track_reference_frame = frame.index;
+      local_points_.push_back(p);
+    }
+  }
+}
+
+int Tracker::trackLocalMap(Frame& frame) {
+  updateLocalMap(frame);
+  for (std::size_t i = 0; i < frame.size(); ++i) {
+    MapPoint* p = frame.points[i];
+    if (p == nullptr) continue;
+    p->increaseVisible();
+    p->last_frame_seen = frame.index;
+    p->track_in_view = false;
+  }
+  int to_match = 0;
+  for (MapPoint* p : local_points_) {
+    if (p->last_frame_seen == frame.index || p->isBad()) continue;
+    if (isInFrustum(p, frame, 0.5f)) {
+      p->increaseVisible();
+      ++to_match;
+    }
+  }
+  if (to_match > 0) {
+    float radius = options_.sensor == Sensor::kRgbd ? 3.f : 1.f;
+    if (relocalizations_ > 0 && frame.index < last_relocalization_frame_ + 2) radius = 5.f;
+    matchLocalPoints(frame, local_points_, radius);
+  }
+  optimizeFramePose(frame);
+  int inliers = 0;
+  for (std::size_t i = 0; i < frame.size(); ++i) {
+    MapPoint* p = frame.points[i];
+    if (p == nullptr) continue;
+    if (!frame.outliers[i]) {
+      p->increaseFound();
+      if (p->observationCount() > 0) ++inliers;
+    }
+  }
+  return inliers;
+}
+
+KeyFrameDecision Tracker::decide(const Frame& frame, int inliers) const {
+  if (reference_keyframe_ == nullptr) return KeyFrameDecision::kNo;
+  KeyFrameEvidence e;
+  e.frames_since_keyframe = frame.index - last_keyframe_frame_;
+  e.frames_since_map_update =
+      sink_ != nullptr ? frame.index - std::min(frame.index, sink_->lastOptimizedFrame())
+                       : e.frames_since_keyframe;
+  e.keyframes_in_map = map_.keyFrameCount();
+  e.frame_features = frame.size();
+  e.reference_features = reference_keyframe_->size();
+  e.frame_tracked = static_cast<std::size_t>(inliers);
+  const int min_obs = e.keyframes_in_map <= 2 ? 2 : 3;
+  e.reference_tracked = static_cast<std::size_t>(reference_keyframe_->trackedPointCount(min_obs));
+  e.mapper_accepts = sink_ == nullptr || sink_->acceptsKeyFrames();
+  return decideKeyFrame(options_.keyframes, e);
+}
+
+KeyFrame* Tracker::createKeyFrame(Frame& frame) {
+  KeyFrame* kf = map_.createKeyFrame(frame.index, frame.timestamp, frame.features, *frame.T_cw);
+  const FrameFeatures& f = *frame.features;
+  for (std::size_t i = 0; i < frame.size(); ++i) {
+    MapPoint* p = frame.points[i];
+    if (p != nullptr && !frame.outliers[i] && !p->isBad()) map_.addObservation(p, kf, i);
+  }
+  if (options_.sensor != Sensor::kMonocular) {
+    // New points from depth for the closest keypoints that have none (at least 100 of them).
+    std::vector<std::pair<float, std::size_t>> by_depth;
+    for (std::size_t i = 0; i < frame.size(); ++i) {
+      if (f.hasDepth(i)) by_depth.emplace_back(f.depth[i], i);
+    }
+    std::sort(by_depth.begin(), by_depth.end());
+    const SE3d T_wc = frame.T_cw->inverse();
+    int created_or_existing = 0;
+    for (const auto& [depth, i] : by_depth) {
+      if (kf->point(i) == nullptr) {
+        const cv::Point2f& pt = f.keypoints[i].pt;
+        MapPoint* p = map_.createMapPoint(T_wc * (camera_.unproject({pt.x, pt.y}) * depth), kf);
+        map_.addObservation(p, kf, i);
+        map_.refreshPoint(p);
+        frame.points[i] = p;
+      }
+      ++created_or_existing;
+      if (depth > options_.close_depth_m && created_or_existing > 100) break;
+    }
+  }
+  for (MapPoint* p : kf->goodPoints()) map_.refreshPoint(p);
+  map_.updateConnections(kf);
+  reference_keyframe_ = kf;
+  last_keyframe_ = kf;
+  last_keyframe_frame_ = frame.index;
+  frame.reference_keyframe = kf;
+  return kf;
+}
+
+void Tracker::record(const Frame& frame, bool tracked) {
+  FrameRecord r;
+  r.index = frame.index;
+  r.timestamp = frame.timestamp;
+  r.tracked = tracked && frame.T_cw.has_value();
+  if (r.tracked) {
+    r.T_cw = *frame.T_cw;
+    r.reference = frame.reference_keyframe != nullptr ? frame.reference_keyframe
+                                                      : reference_keyframe_;
+    if (r.reference != nullptr) r.T_cr = r.T_cw * r.reference->poseInverse();
+  }
+  records_.push_back(r);
+}
+
+void Tracker::resetMap() {
+  std::lock_guard lock(map_.updateMutex());
+  map_.clear();
+  for (FrameRecord& r : records_) {
+    r.tracked = false;
+    r.reference = nullptr;
+  }
+  state_ = TrackingState::kNotInitialized;
+  last_frame_.reset();
+  velocity_.reset();
+  reference_keyframe_ = nullptr;
+  last_keyframe_ = nullptr;
+  local_keyframes_.clear();
+  local_points_.clear();
+  frames_lost_ = 0;
+  ++resets_;
+}
+
+}  // namespace edgeslam

@@ -1,0 +1,94 @@
+#pragma once
+// Camera tracking against the map at frame rate: initialisation, constant-velocity motion model with
+// guided projection search, reference-keyframe fallback, local-map tracking, pose-only optimisation,
+// the keyframe decision and keyframe creation. One instance per camera; not thread-safe itself, but it
+// holds the map's update mutex while it reads or changes the map, so a mapper may run beside it.
+#include <cstddef>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "client/keyframe_policy.h"
+#include "client/monocular_initializer.h"
+#include "client/tracking_types.h"
+#include "geometry/camera.h"
+#include "map/frame.h"
+#include "map/map.h"
+
+namespace edgeslam {
+
+struct TrackerOptions {
+  Sensor sensor = Sensor::kMonocular;
+  KeyFrameParameters keyframes;
+  MonocularInitializerOptions monocular_init;
+  int rgbd_init_min_features = 500;
+  // RGB-D: keypoints closer than this (metres) become points at keyframe creation ("close" depth).
+  float close_depth_m = 3.2f;
+  int min_inliers_motion = 10;
+  int min_inliers_local_map = 30;
+  int min_inliers_local_map_after_relocalization = 50;
+  std::size_t max_local_keyframes = 80;
+};
+
+class Tracker {
+ public:
+  Tracker(Map& map, const PinholeCamera& camera, TrackerOptions options, KeyFrameSink* sink);
+
+  TrackResult track(std::size_t frame_index, double timestamp,
+                    std::shared_ptr<const FrameFeatures> features);
+
+  TrackingState state() const { return state_; }
+  const TrackerOptions& options() const { return options_; }
+  KeyFrameParameters& keyframeParameters() { return options_.keyframes; }
+
+  // Per processed frame: the reference keyframe and the frame's pose relative to it, so that the
+  // final trajectory follows later corrections of the keyframes.
+  struct FrameRecord {
+    std::size_t index = 0;
+    double timestamp = 0.0;
+    bool tracked = false;
+    KeyFrame* reference = nullptr;
+    SE3d T_cr;  // camera-from-reference-keyframe
+    SE3d T_cw;  // the pose estimated at the frame's time
+  };
+  const std::vector<FrameRecord>& records() const { return records_; }
+  std::size_t relocalizations() const { return relocalizations_; }
+  std::size_t resets() const { return resets_; }
+
+ private:
+  bool initialize(Frame& frame);
+  bool initializeRgbd(Frame& frame);
+  bool trackWithMotionModel(Frame& frame);
+  bool trackReferenceKeyFrame(Frame& frame);
+  bool relocalize(Frame& frame);
+  int trackLocalMap(Frame& frame);
+  void updateLocalMap(const Frame& frame);
+  void addPointsFromLastFrameDepth(Frame& last);
+  int discardOutliers(Frame& frame);
+  KeyFrameDecision decide(const Frame& frame, int inliers) const;
+  KeyFrame* createKeyFrame(Frame& frame);
+  void record(const Frame& frame, bool tracked);
+  void resetMap();
+
+  Map& map_;
+  const PinholeCamera& camera_;
+  TrackerOptions options_;
+  KeyFrameSink* sink_;
+  MonocularInitializer mono_init_;
+
+  TrackingState state_ = TrackingState::kNotInitialized;
+  std::optional<Frame> last_frame_;
+  std::optional<SE3d> velocity_;  // T_cw(current) * T_wc(last)
+  KeyFrame* reference_keyframe_ = nullptr;
+  KeyFrame* last_keyframe_ = nullptr;
+  std::size_t last_keyframe_frame_ = 0;
+  std::size_t last_relocalization_frame_ = 0;
+  std::vector<KeyFrame*> local_keyframes_;
+  std::vector<MapPoint*> local_points_;
+  std::vector<FrameRecord> records_;
+  std::size_t relocalizations_ = 0;
+  std::size_t resets_ = 0;
+  std::size_t frames_lost_ = 0;
+};
+
+}  // namespace edgeslam

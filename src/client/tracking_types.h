@@ -1,0 +1,24 @@
+#pragma once
+// Shared vocabulary of the tracker and whoever consumes its keyframes.
+#include <cstddef>
+#include <optional>
+
+#include "geometry/se3.h"
+#include "map/keyframe_sink.h"
+#include "map/sensor.h"
+
+namespace edgeslam {
+
+enum class TrackingState { kNotInitialized, kOk, kLost };
+
+const char* toString(TrackingState state);
+
+struct TrackResult {
+  TrackingState state = TrackingState::kNotInitialized;
+  std::optional<SE3d> T_cw;  // camera-from-world when tracked
+  bool new_keyframe = false;
+  bool relocalized = false;
+  int tracked_points = 0;
+};
+
+}  // namespace edgeslam

@@ -1,0 +1,318 @@
+#include "edge/local_mapper.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "geometry/triangulation.h"
+#include "map/map_matching.h"
+
+namespace edgeslam {
+
+LocalMapper::LocalMapper(Map& map, const PinholeCamera& camera, LocalMapperOptions options)
+    : map_(map), camera_(camera), options_(options) {}
+
+LocalMapper::~LocalMapper() { stop(); }
+
+void LocalMapper::start() {
+  if (thread_.joinable()) return;
+  stopping_ = false;
+  thread_ = std::thread([this] { run(); });
+}
+
+void LocalMapper::stop() {
+  {
+    std::lock_guard lock(queue_mutex_);
+    stopping_ = true;
+  }
+  abort_ba_ = true;
+  queue_cv_.notify_all();
+  if (thread_.joinable()) thread_.join();
+}
+
+void LocalMapper::insertKeyFrame(KeyFrame* keyframe) {
+  {
+    std::lock_guard lock(queue_mutex_);
+    queue_.push_back(keyframe);
+  }
+  abort_ba_ = true;  // a running local BA gives way to the new keyframe
+  queue_cv_.notify_one();
+}
+
+bool LocalMapper::acceptsKeyFrames() const {
+  std::lock_guard lock(queue_mutex_);
+  return queue_.size() < options_.max_queue;
+}
+
+void LocalMapper::onMapReset() {
+  std::lock_guard lock(queue_mutex_);
+  queue_.clear();
+  recent_points_.clear();
+}
+
+bool LocalMapper::hasPending() const {
+  std::lock_guard lock(queue_mutex_);
+  return !queue_.empty();
+}
+
+LocalMapperStats LocalMapper::stats() const {
+  std::lock_guard lock(stats_mutex_);
+  return stats_;
+}
+
+void LocalMapper::waitUntilIdle() {
+  if (!thread_.joinable()) {
+    processAll();
+    return;
+  }
+  std::unique_lock lock(queue_mutex_);
+  idle_cv_.wait(lock, [this] { return queue_.empty() && !busy_; });
+}
+
+void LocalMapper::processAll() {
+  while (true) {
+    KeyFrame* kf = nullptr;
+    {
+      std::lock_guard lock(queue_mutex_);
+      if (queue_.empty()) return;
+      kf = queue_.front();
+      queue_.pop_front();
+    }
+    abort_ba_ = false;
+    processKeyFrame(kf);
+  }
+}
+
+void LocalMapper::run() {
+  while (true) {
+    KeyFrame* kf = nullptr;
+    {
+      std::unique_lock lock(queue_mutex_);
+      busy_ = false;
+      idle_cv_.notify_all();
+      queue_cv_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
+      if (stopping_) return;
+      kf = queue_.front();
+      queue_.pop_front();
+      busy_ = true;
+      abort_ba_ = false;
+    }
+    processKeyFrame(kf);
+  }
+}
+
+void LocalMapper::processKeyFrame(KeyFrame* keyframe) {
+  {
+    std::lock_guard lock(map_.updateMutex());
+    if (keyframe->isBad()) return;
+    linkKeyFrame(keyframe);
+    cullRecentPoints(keyframe);
+  }
+  createNewPoints(keyframe);
+  if (!hasPending()) fuseWithNeighbours(keyframe);
+  if (!hasPending()) {
+    bool enough_keyframes = false;
+    {
+      std::lock_guard lock(map_.updateMutex());
+      enough_keyframes = map_.keyFrameCount() > 2 && !keyframe->isBad();
+    }
+    if (enough_keyframes && options_.run_local_ba) {
+      localBundleAdjustment(map_, keyframe, camera_, &abort_ba_);
+      std::lock_guard lock(stats_mutex_);
+      ++stats_.local_ba_runs;
+    }
+    if (options_.cull_keyframes) cullKeyFrames(keyframe);
+  }
+  last_optimized_frame_ = keyframe->frameIndex();
+  std::lock_guard lock(stats_mutex_);
+  ++stats_.keyframes_processed;
+}
+
+void LocalMapper::linkKeyFrame(KeyFrame* keyframe) {
+  // Tracking linked the observations; points the keyframe created itself (RGB-D) are recent.
+  for (MapPoint* p : keyframe->goodPoints()) {
+    if (p->firstKeyFrameId() == keyframe->id()) recent_points_.push_back(p);
+    map_.refreshPoint(p);
+  }
+  map_.updateConnections(keyframe);
+}
+
+void LocalMapper::cullRecentPoints(KeyFrame* keyframe) {
+  // A new point must be found in at least a quarter of the frames that should see it, and, once
+  // two keyframes have passed, be seen by enough keyframes.
+  const int min_observations = options_.monocular ? 2 : 3;
+  const KeyFrameId current = keyframe->id();
+  std::size_t culled = 0;
+  for (auto it = recent_points_.begin(); it != recent_points_.end();) {
+    MapPoint* p = *it;
+    const KeyFrameId born = p->firstKeyFrameId();
+    const std::uint64_t age = (current & 0x00FFFFFFFFFFFFFF) - (born & 0x00FFFFFFFFFFFFFF);
+    if (p->isBad()) {
+      it = recent_points_.erase(it);
+    } else if (p->foundRatio() < 0.25f || (age >= 2 && p->observationCount() <= min_observations)) {
+      map_.erasePoint(p);
+      ++culled;
+      it = recent_points_.erase(it);
+    } else if (age >= 3) {
+      it = recent_points_.erase(it);
+    } else {
+      ++it;
+    }
+  }
+  std::lock_guard lock(stats_mutex_);
+  stats_.points_culled += culled;
+}
+
+void LocalMapper::createNewPoints(KeyFrame* keyframe) {
+  const bool mono = options_.monocular;
+  std::vector<KeyFrame*> neighbours;
+  {
+    std::lock_guard lock(map_.updateMutex());
+    if (keyframe->isBad()) return;
+    neighbours = keyframe->bestCovisibles(mono ? options_.triangulation_neighbours_mono
+                                               : options_.triangulation_neighbours_depth);
+  }
+  const FrameFeatures& f1 = keyframe->features();
+  const ScaleLevels& scales = f1.scales;
+  const double ratio_factor = 1.5 * scales.scaleFactor();
+  std::size_t created = 0;
+
+  for (KeyFrame* neighbour : neighbours) {
+    if (hasPending() && created > 0) break;
+    std::lock_guard lock(map_.updateMutex());
+    if (neighbour->isBad() || keyframe->isBad()) continue;
+    const SE3d T1 = keyframe->pose();
+    const SE3d T2 = neighbour->pose();
+    const Eigen::Vector3d c1 = keyframe->cameraCenter();
+    const Eigen::Vector3d c2 = neighbour->cameraCenter();
+    const double baseline = (c2 - c1).norm();
+    if (mono) {
+      const double depth = neighbour->medianSceneDepth();
+      if (depth <= 0.0 || baseline / depth < 0.01) continue;
+    } else if (f1.bf > 0.f && baseline < f1.bf / camera_.fx()) {
+      continue;
+    }
+    const auto pairs = matchForTriangulation(*keyframe, *neighbour, camera_, mono);
+    const FrameFeatures& f2 = neighbour->features();
+    for (const auto& [i1, i2] : pairs) {
+      if (keyframe->point(i1) != nullptr || neighbour->point(i2) != nullptr) continue;
+      const cv::KeyPoint& kp1 = f1.keypoints[i1];
+      const cv::KeyPoint& kp2 = f2.keypoints[i2];
+      const Eigen::Vector2d px1(kp1.pt.x, kp1.pt.y), px2(kp2.pt.x, kp2.pt.y);
+      const Eigen::Vector3d ray1 = T1.rotation().conjugate() * camera_.unproject(px1).normalized();
+      const Eigen::Vector3d ray2 = T2.rotation().conjugate() * camera_.unproject(px2).normalized();
+      const double ray_cos = ray1.dot(ray2);
+      const bool depth1 = f1.hasDepth(i1), depth2 = f2.hasDepth(i2);
+      // Parallax a stereo/depth measurement would give, to decide between rays and depth.
+      const double depth_cos1 = depth1 ? std::cos(2 * std::atan2(f1.bf / camera_.fx() / 2, f1.depth[i1])) : 1.1;
+      const double depth_cos2 = depth2 ? std::cos(2 * std::atan2(f2.bf / camera_.fx() / 2, f2.depth[i2])) : 1.1;
+      const double depth_cos = std::min(depth_cos1, depth_cos2);
+
+      std::optional<Eigen::Vector3d> x;
+      if (ray_cos > 0 && ray_cos < depth_cos && (depth1 || depth2 || ray_cos < 0.9998)) {
+        x = triangulateDlt(T1, camera_.unproject(px1).head<2>(), T2,
+                           camera_.unproject(px2).head<2>());
+      } else if (depth1 && depth_cos1 < depth_cos2) {
+        x = keyframe->poseInverse() * (camera_.unproject(px1) * f1.depth[i1]);
+      } else if (depth2 && depth_cos2 < depth_cos1) {
+        x = neighbour->poseInverse() * (camera_.unproject(px2) * f2.depth[i2]);
+      }
+      if (!x || !x->allFinite()) continue;
+      if (!isInFrontOfBoth(T1, T2, *x)) continue;
+      // Reprojection in both keyframes, at each keypoint's level.
+      const double chi1 = reprojectionErrorSquared(camera_, T1, *x, px1) *
+                          scales.invSigma2(kp1.octave);
+      const double chi2 = reprojectionErrorSquared(camera_, T2, *x, px2) *
+                          f2.scales.invSigma2(kp2.octave);
+      if (chi1 > 5.991 || chi2 > 5.991) continue;
+      // Scale consistency: distance ratio must agree with the pyramid level ratio.
+      const double dist1 = (*x - c1).norm(), dist2 = (*x - c2).norm();
+      if (dist1 <= 0 || dist2 <= 0) continue;
+      const double ratio_dist = dist2 / dist1;
+      const double ratio_octave = scales.scale(kp1.octave) / f2.scales.scale(kp2.octave);
+      if (ratio_dist * ratio_factor < ratio_octave || ratio_dist > ratio_octave * ratio_factor) {
+        continue;
+      }
+      MapPoint* p = map_.createMapPoint(*x, keyframe);
+      map_.addObservation(p, keyframe, i1);
+      map_.addObservation(p, neighbour, i2);
+      map_.refreshPoint(p);
+      recent_points_.push_back(p);
+      ++created;
+    }
+  }
+  std::lock_guard lock(stats_mutex_);
+  stats_.points_created += created;
+}
+
+void LocalMapper::fuseWithNeighbours(KeyFrame* keyframe) {
+  std::lock_guard lock(map_.updateMutex());
+  if (keyframe->isBad()) return;
+  const std::size_t n =
+      options_.monocular ? options_.fusion_neighbours_mono : options_.fusion_neighbours_depth;
+  std::vector<KeyFrame*> targets;
+  for (KeyFrame* kf : keyframe->bestCovisibles(n)) {
+    if (kf->isBad() || kf->fuse_target_for == keyframe->id()) continue;
+    kf->fuse_target_for = keyframe->id();
+    targets.push_back(kf);
+    for (KeyFrame* kf2 : kf->bestCovisibles(5)) {
+      if (kf2->isBad() || kf2 == keyframe || kf2->fuse_target_for == keyframe->id()) continue;
+      kf2->fuse_target_for = keyframe->id();
+      targets.push_back(kf2);
+    }
+  }
+  // The keyframe's points into its neighbours, then the neighbours' points into the keyframe.
+  const std::vector<MapPoint*> own = keyframe->goodPoints();
+  for (KeyFrame* target : targets) fuse(map_, target, own, camera_);
+  std::vector<MapPoint*> theirs;
+  for (KeyFrame* target : targets) {
+    for (MapPoint* p : target->goodPoints()) {
+      if (p->fuse_candidate_for == keyframe->id()) continue;
+      p->fuse_candidate_for = keyframe->id();
+      theirs.push_back(p);
+    }
+  }
+  fuse(map_, keyframe, theirs, camera_);
+  for (MapPoint* p : keyframe->goodPoints()) map_.refreshPoint(p);
+  map_.updateConnections(keyframe);
+}
+
+void LocalMapper::cullKeyFrames(KeyFrame* keyframe) {
+  // A keyframe is redundant when 90 % of its points are seen, at the same or a finer scale, by at
+  // least three other keyframes.
+  std::lock_guard lock(map_.updateMutex());
+  if (keyframe->isBad()) return;
+  std::size_t culled = 0;
+  for (KeyFrame* kf : keyframe->bestCovisibles(static_cast<std::size_t>(-1))) {
+    if (kf->isBad() || kf == map_.originKeyFrame() || kf->isProtected()) continue;
+    const FrameFeatures& f = kf->features();
+    const float close_depth = 40.f * f.bf / static_cast<float>(camera_.fx());
+    int points = 0, redundant = 0;
+    for (std::size_t i = 0; i < kf->size(); ++i) {
+      MapPoint* p = kf->point(i);
+      if (p == nullptr || p->isBad()) continue;
+      // With depth, only close points (those measured well by it) count.
+      if (!options_.monocular && (!f.hasDepth(i) || f.depth[i] > close_depth)) continue;
+      ++points;
+      if (p->observations().size() <= 3) continue;
+      const int level = f.keypoints[i].octave;
+      int seen_by = 0;
+      for (const auto& [id, obs] : p->observations()) {
+        if (obs.keyframe == kf) continue;
+        if (obs.keyframe->features().keypoints[obs.index].octave <= level + 1 && ++seen_by >= 3) {
+          break;
+        }
+      }
+      if (seen_by >= 3) ++redundant;
+    }
+    if (points > 0 && redundant > options_.redundant_ratio * points) {
+      map_.eraseKeyFrame(kf);
+      ++culled;
+    }
+  }
+  std::lock_guard stats_lock(stats_mutex_);
+  stats_.keyframes_culled += culled;
+}
+
+}  // namespace edgeslam

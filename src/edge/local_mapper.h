@@ -1,0 +1,87 @@
+#pragma once
+// Local mapping: takes keyframes from tracking and, on its own thread, links their points, culls weak
+// recent points, triangulates new points with neighbour keyframes, fuses duplicates, runs local bundle
+// adjustment and removes redundant keyframes. Every map change goes through Map under its mutex.
+#include <atomic>
+#include <condition_variable>
+#include <cstddef>
+#include <deque>
+#include <list>
+#include <mutex>
+#include <thread>
+
+#include "geometry/camera.h"
+#include "map/keyframe_sink.h"
+#include "map/map.h"
+#include "optimize/map_optimization.h"
+
+namespace edgeslam {
+
+struct LocalMapperOptions {
+  bool monocular = true;
+  std::size_t triangulation_neighbours_mono = 20;
+  std::size_t triangulation_neighbours_depth = 10;
+  std::size_t fusion_neighbours_mono = 20;
+  std::size_t fusion_neighbours_depth = 10;
+  std::size_t max_queue = 3;  // tracking is asked to wait beyond this backlog
+  double redundant_ratio = 0.9;  // a keyframe whose points are 90 % seen by 3+ others is culled
+  bool run_local_ba = true;
+  bool cull_keyframes = true;
+};
+
+struct LocalMapperStats {
+  std::size_t keyframes_processed = 0;
+  std::size_t points_created = 0;
+  std::size_t points_culled = 0;
+  std::size_t keyframes_culled = 0;
+  std::size_t local_ba_runs = 0;
+};
+
+class LocalMapper : public KeyFrameSink {
+ public:
+  LocalMapper(Map& map, const PinholeCamera& camera, LocalMapperOptions options);
+  ~LocalMapper() override;
+
+  // Runs on its own thread until stop(); without start(), call processAll() to map synchronously.
+  void start();
+  void stop();
+  void processAll();
+  void waitUntilIdle();
+
+  void insertKeyFrame(KeyFrame* keyframe) override;
+  bool acceptsKeyFrames() const override;
+  std::size_t lastOptimizedFrame() const override { return last_optimized_frame_.load(); }
+  void onMapReset() override;
+
+  LocalMapperStats stats() const;
+
+ private:
+  void run();
+  void processKeyFrame(KeyFrame* keyframe);
+  void linkKeyFrame(KeyFrame* keyframe);
+  void cullRecentPoints(KeyFrame* keyframe);
+  void createNewPoints(KeyFrame* keyframe);
+  void fuseWithNeighbours(KeyFrame* keyframe);
+  void cullKeyFrames(KeyFrame* keyframe);
+  bool hasPending() const;
+
+  Map& map_;
+  const PinholeCamera& camera_;
+  LocalMapperOptions options_;
+
+  mutable std::mutex queue_mutex_;
+  std::condition_variable queue_cv_;
+  std::condition_variable idle_cv_;
+  std::deque<KeyFrame*> queue_;
+  bool busy_ = false;
+  bool stopping_ = false;
+  std::thread thread_;
+
+  std::atomic<bool> abort_ba_{false};
+  std::atomic<std::size_t> last_optimized_frame_{0};
+  std::list<MapPoint*> recent_points_;
+  mutable std::mutex stats_mutex_;
+  LocalMapperStats stats_;
+};
+
+}  // namespace edgeslam

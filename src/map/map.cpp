@@ -1,0 +1,243 @@
+#include "map/map.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace edgeslam {
+
+Map::Map(std::uint8_t id_origin) : ids_(id_origin) {}
+
+KeyFrame* Map::createKeyFrame(std::size_t frame_index, double timestamp,
+                              std::shared_ptr<const FrameFeatures> features, const SE3d& T_cw,
+                              KeyFrameId id) {
+  if (id == kInvalidId) {
+    id = ids_.next();
+  } else {
+    ids_.advancePast(id);
+  }
+  auto keyframe = std::make_unique<KeyFrame>(id, frame_index, timestamp, std::move(features), T_cw);
+  KeyFrame* raw = keyframe.get();
+  if (!keyframes_.emplace(id, std::move(keyframe)).second) {
+    throw std::logic_error("Map: duplicate keyframe id");
+  }
+  if (origin_ == nullptr) origin_ = raw;
+  changes_.keyFrameCreated(id);
+  return raw;
+}
+
+MapPoint* Map::createMapPoint(const Eigen::Vector3d& position, KeyFrame* reference, MapPointId id) {
+  if (id == kInvalidId) {
+    id = ids_.next();
+  } else {
+    ids_.advancePast(id);
+  }
+  auto point = std::make_unique<MapPoint>(id, position, reference);
+  MapPoint* raw = point.get();
+  if (!points_.emplace(id, std::move(point)).second) {
+    throw std::logic_error("Map: duplicate map point id");
+  }
+  changes_.pointCreated(id);
+  return raw;
+}
+
+void Map::addObservation(MapPoint* point, KeyFrame* keyframe, std::size_t index) {
+  if (point->isBad() || keyframe->isBad()) return;
+  if (keyframe->points_[index] != nullptr && keyframe->points_[index] != point) {
+    eraseObservation(keyframe->points_[index], keyframe);
+  }
+  const auto [it, inserted] = point->observations_.try_emplace(keyframe->id(), keyframe, index);
+  if (!inserted) {
+    if (it->second.index == index) return;
+    keyframe->points_[it->second.index] = nullptr;
+    it->second.index = index;
+  } else {
+    point->observation_weight_ += keyframe->features().hasDepth(index) ? 2 : 1;
+  }
+  keyframe->points_[index] = point;
+  changes_.pointUpdated(point->id());
+}
+
+void Map::eraseObservation(MapPoint* point, KeyFrame* keyframe) {
+  const auto it = point->observations_.find(keyframe->id());
+  if (it == point->observations_.end()) return;
+  const std::size_t index = it->second.index;
+  point->observation_weight_ -= keyframe->features().hasDepth(index) ? 2 : 1;
+  point->observations_.erase(it);
+  if (keyframe->points_[index] == point) keyframe->points_[index] = nullptr;
+  if (point->reference_keyframe_ == keyframe && !point->observations_.empty()) {
+    point->reference_keyframe_ = point->observations_.begin()->second.keyframe;
+  }
+  if (point->observation_weight_ <= 2) {
+    erasePoint(point);
+  } else {
+    changes_.pointUpdated(point->id());
+  }
+}
+
+void Map::erasePoint(MapPoint* point) {
+  if (point->bad_) return;
+  point->bad_ = true;
+  for (const auto& [id, obs] : point->observations_) {
+    if (obs.keyframe->points_[obs.index] == point) obs.keyframe->points_[obs.index] = nullptr;
+  }
+  point->observations_.clear();
+  point->observation_weight_ = 0;
+  changes_.pointErased(point->id());
+  auto node = points_.extract(point->id());
+  if (!node.empty()) retired_points_.push_back(std::move(node.mapped()));
+}
+
+void Map::replacePoint(MapPoint* old_point, MapPoint* replacement) {
+  if (old_point == replacement || old_point->isBad() || replacement->isBad()) return;
+  const auto observations = old_point->observations_;
+  for (const auto& [id, obs] : observations) {
+    if (replacement->observations_.contains(id)) {
+      // Both seen in this keyframe: keep the replacement's keypoint, drop the old one's.
+      continue;
+    }
+    obs.keyframe->points_[obs.index] = nullptr;
+    addObservation(replacement, obs.keyframe, obs.index);
+  }
+  replacement->increaseVisible(old_point->visible_);
+  replacement->increaseFound(old_point->found_);
+  old_point->replaced_by_ = replacement;
+  erasePoint(old_point);
+  refreshPoint(replacement);
+}
+
+void Map::setPointPosition(MapPoint* point, const Eigen::Vector3d& position) {
+  point->position_ = position;
+  changes_.pointUpdated(point->id());
+}
+
+void Map::refreshPoint(MapPoint* point) {
+  if (point->isBad()) return;
+  point->computeDistinctiveDescriptor();
+  point->updateNormalAndDepth();
+  changes_.pointUpdated(point->id());
+}
+
+void Map::setKeyFramePose(KeyFrame* keyframe, const SE3d& T_cw) {
+  keyframe->setPose(T_cw);
+  changes_.keyFrameUpdated(keyframe->id());
+}
+
+void Map::updateConnections(KeyFrame* keyframe) {
+  keyframe->updateConnections();
+  changes_.keyFrameUpdated(keyframe->id());
+}
+
+void Map::eraseKeyFrame(KeyFrame* keyframe) {
+  if (keyframe->bad_ || keyframe == origin_ || keyframe->protected_from_culling_) return;
+  for (auto& [kf, w] : keyframe->connection_weights_) {
+    kf->connection_weights_.erase(keyframe);
+    auto& theirs = kf->ordered_connections_;
+    theirs.erase(std::remove_if(theirs.begin(), theirs.end(),
+                                [keyframe](const auto& e) { return e.second == keyframe; }),
+                 theirs.end());
+  }
+  keyframe->connection_weights_.clear();
+  keyframe->ordered_connections_.clear();
+  for (std::size_t i = 0; i < keyframe->points_.size(); ++i) {
+    if (MapPoint* p = keyframe->points_[i]) eraseObservation(p, keyframe);
+  }
+
+  // Re-parent the children: repeatedly attach the child with the strongest covisibility link to any
+  // keyframe already in the tree (the erased keyframe's parent to start with).
+  KeyFrameSet candidates;
+  if (keyframe->parent_ != nullptr) candidates.insert(keyframe->parent_);
+  KeyFrameSet orphans = keyframe->children_;
+  while (!orphans.empty()) {
+    KeyFrame* best_child = nullptr;
+    KeyFrame* best_parent = nullptr;
+    int best_weight = -1;
+    for (KeyFrame* child : orphans) {
+      if (child->isBad()) continue;
+      for (KeyFrame* candidate : candidates) {
+        const int w = child->weight(candidate);
+        if (w > best_weight) {
+          best_weight = w;
+          best_child = child;
+          best_parent = candidate;
+        }
+      }
+    }
+    if (best_child == nullptr || best_weight <= 0) break;
+    best_child->parent_ = best_parent;
+    best_parent->children_.insert(best_child);
+    candidates.insert(best_child);
+    orphans.erase(best_child);
+    changes_.keyFrameUpdated(best_child->id());
+  }
+  for (KeyFrame* orphan : orphans) {  // no covisible link left: hang them on the old parent
+    orphan->parent_ = keyframe->parent_;
+    if (keyframe->parent_ != nullptr) keyframe->parent_->children_.insert(orphan);
+  }
+  if (keyframe->parent_ != nullptr) {
+    keyframe->parent_->children_.erase(keyframe);
+    keyframe->T_cp_ = keyframe->T_cw_ * keyframe->parent_->T_wc_;
+  }
+  keyframe->children_.clear();
+  keyframe->bad_ = true;
+  changes_.keyFrameErased(keyframe->id());
+  auto node = keyframes_.extract(keyframe->id());
+  if (!node.empty()) retired_keyframes_.push_back(std::move(node.mapped()));
+}
+
+void Map::addLoopEdge(KeyFrame* a, KeyFrame* b) {
+  a->loop_edges_.insert(b);
+  b->loop_edges_.insert(a);
+  a->protected_from_culling_ = true;
+  b->protected_from_culling_ = true;
+  changes_.keyFrameUpdated(a->id());
+  changes_.keyFrameUpdated(b->id());
+}
+
+void Map::clear() {
+  for (auto& [id, p] : points_) {
+    p->bad_ = true;
+    retired_points_.push_back(std::move(p));
+  }
+  for (auto& [id, kf] : keyframes_) {
+    kf->bad_ = true;
+    retired_keyframes_.push_back(std::move(kf));
+  }
+  points_.clear();
+  keyframes_.clear();
+  origin_ = nullptr;
+  changes_.clear();
+}
+
+std::vector<KeyFrame*> Map::keyFrames() const {
+  std::vector<KeyFrame*> out;
+  out.reserve(keyframes_.size());
+  for (const auto& [id, kf] : keyframes_) out.push_back(kf.get());
+  std::sort(out.begin(), out.end(), KeyFrameIdLess{});
+  return out;
+}
+
+std::vector<MapPoint*> Map::mapPoints() const {
+  std::vector<MapPoint*> out;
+  out.reserve(points_.size());
+  for (const auto& [id, p] : points_) out.push_back(p.get());
+  std::sort(out.begin(), out.end(), [](auto* a, auto* b) { return a->id() < b->id(); });
+  return out;
+}
+
+KeyFrame* Map::keyFrame(KeyFrameId id) const {
+  const auto it = keyframes_.find(id);
+  return it == keyframes_.end() ? nullptr : it->second.get();
+}
+
+MapPoint* Map::mapPoint(MapPointId id) const {
+  const auto it = points_.find(id);
+  return it == points_.end() ? nullptr : it->second.get();
+}
+
+MapChanges Map::takeChanges() {
+  MapChanges out = std::move(changes_);
+  changes_.clear();
+  return out;
+}
+
+}  // namespace edgeslam

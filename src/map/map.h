@@ -1,0 +1,78 @@
+#pragma once
+// The map: owns keyframes and points by id and is the single place where they change, so every change
+// is recorded (MapChanges) for the slices that keep client and edge in step.
+//
+// Thread safety: callers hold updateMutex() around any sequence of calls that reads or changes the map
+// from more than one thread (tracking holds it for a frame; mapping for each change it applies).
+// Erased elements stay allocated until the Map is destroyed, so raw pointers never dangle.
+#include <memory>
+#include <mutex>
+#include <unordered_map>
+#include <vector>
+
+#include "map/keyframe.h"
+#include "map/map_changes.h"
+#include "map/map_point.h"
+
+namespace edgeslam {
+
+class Map {
+ public:
+  explicit Map(std::uint8_t id_origin = 0);
+  Map(const Map&) = delete;
+  Map& operator=(const Map&) = delete;
+
+  std::mutex& updateMutex() const { return update_mutex_; }
+
+  // Creation. `id` = kInvalidId allocates a fresh one; a given id is used as is (replicas).
+  KeyFrame* createKeyFrame(std::size_t frame_index, double timestamp,
+                           std::shared_ptr<const FrameFeatures> features, const SE3d& T_cw,
+                           KeyFrameId id = kInvalidId);
+  MapPoint* createMapPoint(const Eigen::Vector3d& position, KeyFrame* reference,
+                           MapPointId id = kInvalidId);
+
+  // Observations link a point and a keypoint both ways.
+  void addObservation(MapPoint* point, KeyFrame* keyframe, std::size_t index);
+  // Unlinks; a point left with fewer than two observations is erased.
+  void eraseObservation(MapPoint* point, KeyFrame* keyframe);
+  void erasePoint(MapPoint* point);
+  // Moves every observation of `old_point` to `replacement` (point fusion) and erases `old_point`.
+  void replacePoint(MapPoint* old_point, MapPoint* replacement);
+  void setPointPosition(MapPoint* point, const Eigen::Vector3d& position);
+  // Recomputes normal, distance range and representative descriptor from the observations.
+  void refreshPoint(MapPoint* point);
+
+  void setKeyFramePose(KeyFrame* keyframe, const SE3d& T_cw);
+  void updateConnections(KeyFrame* keyframe);
+  // Removes a redundant keyframe: unlinks its observations and re-parents its spanning-tree children.
+  void eraseKeyFrame(KeyFrame* keyframe);
+  void addLoopEdge(KeyFrame* a, KeyFrame* b);
+  // Empties the map (a failed start); ids keep counting up.
+  void clear();
+  void protectKeyFrame(KeyFrame* keyframe) { keyframe->protected_from_culling_ = true; }
+
+  std::size_t keyFrameCount() const { return keyframes_.size(); }
+  std::size_t pointCount() const { return points_.size(); }
+  std::vector<KeyFrame*> keyFrames() const;  // sorted by id
+  std::vector<MapPoint*> mapPoints() const;  // sorted by id
+  KeyFrame* keyFrame(KeyFrameId id) const;   // nullptr when absent or erased
+  MapPoint* mapPoint(MapPointId id) const;
+  KeyFrame* originKeyFrame() const { return origin_; }
+
+  const MapChanges& changes() const { return changes_; }
+  MapChanges takeChanges();
+
+  IdAllocator& ids() { return ids_; }
+
+ private:
+  mutable std::mutex update_mutex_;
+  IdAllocator ids_;
+  std::unordered_map<KeyFrameId, std::unique_ptr<KeyFrame>> keyframes_;
+  std::unordered_map<MapPointId, std::unique_ptr<MapPoint>> points_;
+  std::vector<std::unique_ptr<KeyFrame>> retired_keyframes_;
+  std::vector<std::unique_ptr<MapPoint>> retired_points_;
+  KeyFrame* origin_ = nullptr;
+  MapChanges changes_;
+};
+
+}  // namespace edgeslam

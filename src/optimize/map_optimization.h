@@ -1,0 +1,44 @@
+#pragma once
+// Adapters between the map types and the Ceres problems: pose-only optimisation of a Frame, local
+// bundle adjustment around a keyframe, and global bundle adjustment. Callers do not hold the map's
+// update mutex: these take it to read the problem and to write the result back, and solve unlocked.
+#include <atomic>
+#include <cstddef>
+
+#include "geometry/camera.h"
+#include "map/frame.h"
+#include "map/map.h"
+#include "optimize/local_bundle_adjustment.h"
+#include "optimize/pose_optimizer.h"
+
+namespace edgeslam {
+
+// Refines frame.T_cw against its matched points (held fixed) and marks frame.outliers. Returns the
+// number of inliers. The caller holds whatever lock protects the points.
+int optimizeFramePose(Frame& frame, const PoseOptimizerOptions& options = {});
+
+struct LocalBundleAdjustmentStats {
+  std::size_t keyframes = 0;        // optimised
+  std::size_t fixed_keyframes = 0;  // seen by the window's points, held fixed
+  std::size_t points = 0;
+  std::size_t observations = 0;
+  std::size_t outliers_removed = 0;
+  double rms_before = 0.0;
+  double rms_after = 0.0;
+  bool cancelled = false;
+  double solve_ms = 0.0;
+};
+
+// Optimises `keyframe` and its covisible keyframes with every point they see; the other keyframes
+// that see those points stay fixed. Locks `map` while reading and writing, not while solving.
+LocalBundleAdjustmentStats localBundleAdjustment(Map& map, KeyFrame* keyframe,
+                                                 const PinholeCamera& camera,
+                                                 const std::atomic<bool>* cancel = nullptr,
+                                                 BundleAdjustmentOptions options = {});
+
+// Every keyframe and point; the origin keyframe fixed. Same locking as above.
+LocalBundleAdjustmentStats globalBundleAdjustment(Map& map, const PinholeCamera& camera,
+                                                  const std::atomic<bool>* cancel = nullptr,
+                                                  int iterations = 20);
+
+}  // namespace edgeslam

@@ -1,0 +1,71 @@
+#include "pipeline/local_slam.h"
+
+namespace edgeslam {
+
+LocalSlamOptions defaultLocalSlamOptions(const PinholeCamera& camera, Sensor sensor) {
+  LocalSlamOptions options;
+  options.sensor = sensor;
+  options.orb.num_features = camera.width() * camera.height() > 640 * 480 * 1.2 ? 2000 : 1000;
+  options.tracker.sensor = sensor;
+  options.mapper.monocular = sensor == Sensor::kMonocular;
+  return options;
+}
+
+LocalSlam::LocalSlam(const PinholeCamera& camera, LocalSlamOptions options)
+    : camera_(camera), options_(std::move(options)), extractor_(options_.orb) {
+  options_.tracker.sensor = options_.sensor;
+  options_.mapper.monocular = options_.sensor == Sensor::kMonocular;
+  mapper_ = std::make_unique<LocalMapper>(map_, camera_, options_.mapper);
+  tracker_ = std::make_unique<Tracker>(map_, camera_, options_.tracker, mapper_.get());
+  if (options_.threaded_mapping) mapper_->start();
+}
+
+LocalSlam::~LocalSlam() { mapper_->stop(); }
+
+TrackResult LocalSlam::process(std::size_t frame_index, double timestamp, const cv::Mat& gray,
+                               const cv::Mat& depth) {
+  const cv::Mat& used_depth = options_.sensor == Sensor::kMonocular ? cv::Mat() : depth;
+  auto features = buildFrameFeatures(gray, used_depth, camera_, extractor_, options_.depth);
+  TrackResult result = tracker_->track(frame_index, timestamp, std::move(features));
+  if (!options_.threaded_mapping) mapper_->processAll();
+  return result;
+}
+
+void LocalSlam::finish() { mapper_->waitUntilIdle(); }
+
+Trajectory LocalSlam::trajectoryAtFrameTime() const {
+  Trajectory out;
+  for (const auto& r : tracker_->records()) {
+    if (r.tracked) out.push_back({r.timestamp, r.T_cw.inverse()});
+  }
+  return out;
+}
+
+Trajectory LocalSlam::trajectoryFinal() const {
+  std::lock_guard lock(map_.updateMutex());
+  Trajectory out;
+  for (const auto& r : tracker_->records()) {
+    if (!r.tracked || r.reference == nullptr) continue;
+    out.push_back({r.timestamp, (r.T_cr * r.reference->latestPose()).inverse()});
+  }
+  return out;
+}
+
+Trajectory LocalSlam::keyframeTrajectory() const {
+  std::lock_guard lock(map_.updateMutex());
+  Trajectory out;
+  for (KeyFrame* kf : map_.keyFrames()) out.push_back({kf->timestamp(), kf->poseInverse()});
+  return out;
+}
+
+std::size_t LocalSlam::keyFrameCount() const {
+  std::lock_guard lock(map_.updateMutex());
+  return map_.keyFrameCount();
+}
+
+std::size_t LocalSlam::mapPointCount() const {
+  std::lock_guard lock(map_.updateMutex());
+  return map_.pointCount();
+}
+
+}  // namespace edgeslam
