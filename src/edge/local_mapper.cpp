@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "geometry/chi_square.h"
 #include "geometry/triangulation.h"
 #include "map/map_matching.h"
 
@@ -221,11 +222,11 @@ void LocalMapper::createNewPoints(KeyFrame* keyframe) {
       if (!x || !x->allFinite()) continue;
       if (!isInFrontOfBoth(T1, T2, *x)) continue;
       // Reprojection in both keyframes, at each keypoint's level.
-      const double chi1 = reprojectionErrorSquared(camera_, T1, *x, px1) *
+      const double error1 = reprojectionErrorSquared(camera_, T1, *x, px1) *
                           scales.invSigma2(kp1.octave);
-      const double chi2 = reprojectionErrorSquared(camera_, T2, *x, px2) *
+      const double error2 = reprojectionErrorSquared(camera_, T2, *x, px2) *
                           f2.scales.invSigma2(kp2.octave);
-      if (chi1 > 5.991 || chi2 > 5.991) continue;
+      if (error1 > chi2::k2Dof95 || error2 > chi2::k2Dof95) continue;
       // Scale consistency: distance ratio must agree with the pyramid level ratio.
       const double dist1 = (*x - c1).norm(), dist2 = (*x - c2).norm();
       if (dist1 <= 0 || dist2 <= 0) continue;
