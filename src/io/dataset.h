@@ -10,6 +10,7 @@
 
 #include "geometry/camera.h"
 #include "geometry/se3.h"
+#include "io/dataset_error.h"
 
 namespace edgeslam {
 
@@ -37,6 +38,8 @@ struct DatasetInfo {
   bool has_depth = false;
   bool has_stereo = false;
   bool has_ground_truth = false;
+  // True when right images are rectified to the left camera (KITTI); EuRoC's are raw.
+  bool stereo_rectified = false;
   double fps = 0.0;  // nominal rate from timestamps or the dataset's documentation
 };
 
@@ -47,23 +50,36 @@ class DatasetReader {
   virtual const PinholeCamera& camera() const = 0;
   // Timestamps of all frames, known without loading images.
   virtual const std::vector<double>& timestamps() const = 0;
+  // Ground truth (camera-to-world) of all frames, known without loading images; one entry per
+  // frame, nullopt where the dataset has none for that frame.
+  virtual const std::vector<std::optional<SE3d>>& groundTruth() const = 0;
   // Loads frame i (0 <= i < frame_count). Throws DatasetError naming the file on bad data.
   virtual DatasetFrame load(std::size_t index) = 0;
 };
 
-// Error with the offending file (and line, when a text file is malformed) in its message.
-class DatasetError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
 struct DatasetOptions {
   DatasetFormat format = DatasetFormat::kAuto;
-  // Overrides the dataset's own camera (the `--camera FILE.yaml` flag).
+  // Overrides the dataset's own camera (the `--camera FILE.yaml` flag). Its size must match the
+  // images. Fields it leaves at 0 (depth_factor, baseline_m, fps) keep the dataset's own values.
   std::optional<CameraIntrinsics> camera_override;
 };
 
-// Opens a dataset folder (or video file), detecting the format when asked to.
+// Opens a dataset folder (or video file), detecting the format when asked to. Per format:
+// - tum: rgb.txt, optional depth.txt (each rgb frame takes the nearest depth within 0.02 s; when
+//   the dataset has depth, rgb frames without one are dropped), optional groundtruth.txt
+//   (interpolated at each frame, see pose_interpolation.h). Camera: camera.yaml in the folder,
+//   else the official Freiburg 1/2/3 calibration when the folder name, a README or the text files'
+//   comments name it, else --camera is required. Depth factor 5000.
+// - kitti: image_0/ (+ image_1/ = rectified stereo), times.txt, calib.txt (P0; baseline from P1),
+//   poses.txt or ../poses/<seq>.txt or ../../poses/<seq>.txt. Image NNNNNN.png takes line NNNNNN
+//   of times and poses, so an excerpt of a sequence can keep the full sequence's files.
+// - euroc: mav0/cam0 (+ cam1, raw stereo paired by timestamp), sensor.yaml, ground truth
+//   state_groundtruth_estimate0 (camera pose = T_WB * T_BS(cam0)).
+// - 7scenes: frame-NNNNNN.{color.png|jpg, depth.png, pose.txt}, camera-intrinsics.txt; frame
+//   number / 30 s; depth 65535 -> 0; non-finite pose files -> no ground truth for that frame.
+// - images: image files in natural order + camera.yaml, optional times.txt and groundtruth.txt.
+// - video: any file videoio decodes + <name>.yaml beside it; timestamps i / fps.
+// All images are checked against the camera's size when loaded; errors name file (and line).
 std::unique_ptr<DatasetReader> openDataset(const std::filesystem::path& path,
                                            const DatasetOptions& options = {});
 
