@@ -41,8 +41,10 @@ test: test-release
 demo: build
 	@./$(BUILD_DIR)/edgeslam run --dataset "$(EDGESLAM_DATA)" --mode edge --out $(DEMO_OUT) $(DEMO_ARGS)
 
+# Micro-benchmarks (pinned to core 0), then the SLAM rows of docs/benchmarks.md (3 runs each).
 bench: build
-	@bash bench/run.sh
+	@BUILD_DIR=$(BUILD_DIR) bash bench/run.sh
+	@python3 bench/slam_bench.py --build $(BUILD_DIR) --shared $(EDGESLAM_SHARED)
 
 format:
 	@git ls-files '*.cpp' '*.h' | xargs clang-format -i

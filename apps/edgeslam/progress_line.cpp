@@ -10,7 +10,9 @@ ProgressLine::ProgressLine(std::FILE* stream)
       last_(std::chrono::steady_clock::now() - std::chrono::hours(1)),
       period_(is_terminal_ ? std::chrono::milliseconds(100) : std::chrono::milliseconds(2000)) {}
 
-ProgressLine::~ProgressLine() { finish(); }
+ProgressLine::~ProgressLine() {
+  finish();
+}
 
 void ProgressLine::update(const std::string& text, bool force) {
   const auto now = std::chrono::steady_clock::now();

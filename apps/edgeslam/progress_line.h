@@ -1,5 +1,6 @@
 #pragma once
-// A live one-line progress display: rewritten in place on a terminal, printed every few seconds otherwise.
+// A live one-line progress display: rewritten in place on a terminal, printed every few seconds
+// otherwise.
 #include <chrono>
 #include <cstdio>
 #include <string>

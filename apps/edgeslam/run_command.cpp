@@ -3,14 +3,14 @@
 #include <spdlog/spdlog.h>
 
 #include <filesystem>
-#include <optional>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <thread>
 
 #include "commands.h"
-#include "io/camera_file.h"
 #include "eval/ate.h"
+#include "io/camera_file.h"
 #include "io/dataset.h"
 #include "io/trajectory.h"
 #include "pipeline/local_slam.h"
@@ -81,7 +81,19 @@ int runPipeline(const RunOptions& options) {
     mode = "local";
   }
 
-  LocalSlam slam(reader->camera(), defaultLocalSlamOptions(reader->camera(), sensor));
+  LocalSlamOptions slam_options = defaultLocalSlamOptions(reader->camera(), sensor);
+  if (options.features) slam_options.orb.num_features = *options.features;
+  if (options.levels) slam_options.orb.num_levels = *options.levels;
+  KeyFrameParameters& kf = slam_options.tracker.keyframes;
+  if (options.fmin) kf.fmin = *options.fmin;
+  if (options.fmax) kf.fmax = *options.fmax;
+  if (options.alpha) kf.alpha = *options.alpha;
+  if (options.beta) kf.beta = *options.beta;
+  slam_options.orb.validate();
+  spdlog::info("{} ORB features, {} levels; keyframes fmin {} fmax {} alpha {} beta {}",
+               slam_options.orb.num_features, slam_options.orb.num_levels, kf.fmin, kf.fmax,
+               kf.alpha, kf.beta);
+  LocalSlam slam(reader->camera(), slam_options);
   SampleStats client_ms, load_ms;
   ProgressLine progress;
   Stopwatch wall;
@@ -92,7 +104,8 @@ int runPipeline(const RunOptions& options) {
     if (options.realtime && i > 0) {
       const double due_ms = (stamps[i] - stamps[0]) * 1000.0;
       const double wait_ms = due_ms - wall.elapsedMs();
-      if (wait_ms > 0) std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(wait_ms));
+      if (wait_ms > 0)
+        std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(wait_ms));
     }
     Stopwatch load_timer;
     const DatasetFrame frame = reader->load(i);
@@ -193,9 +206,11 @@ void addRunCommand(CLI::App& app) {
       ->check(CLI::IsMember({"edge", "local", "offload"}));
   run->add_option("--link", options->link, "Emulated link profile between client and edge");
   run->add_option("--adapt", options->adapt, "Self-adaptation on|off")
-      ->transform(CLI::CheckedTransformer(std::map<std::string, bool>{{"on", true}, {"off", false}}));
+      ->transform(
+          CLI::CheckedTransformer(std::map<std::string, bool>{{"on", true}, {"off", false}}));
   run->add_option("--semantic", options->semantic, "Semantic culling on|off")
-      ->transform(CLI::CheckedTransformer(std::map<std::string, bool>{{"on", true}, {"off", false}}));
+      ->transform(
+          CLI::CheckedTransformer(std::map<std::string, bool>{{"on", true}, {"off", false}}));
   run->add_option("--max-frames", options->max_frames, "Process at most N frames (0 = all)");
   auto* realtime = run->add_flag("--realtime", options->realtime,
                                  "Feed frames at the dataset's rate, dropping none");
@@ -205,6 +220,19 @@ void addRunCommand(CLI::App& app) {
   run->add_option("--viewer", options->viewer_port, "Serve the web viewer on this port");
   run->add_option("--camera", options->camera_file, "Camera YAML overriding the dataset's camera")
       ->check(CLI::ExistingFile);
+  run->add_option("--features", options->features,
+                  "ORB features per frame (default 1000, 2000 above 640x480)")
+      ->check(CLI::Range(100, 20000));
+  run->add_option("--levels", options->levels, "ORB pyramid levels (Table I nl)")
+      ->check(CLI::Range(1, 12));
+  run->add_option("--fmin", options->fmin, "Keyframe rule 1: frames since the last keyframe")
+      ->check(CLI::Range(0, 1000));
+  run->add_option("--fmax", options->fmax, "Keyframe rule 2: frames since the last map update")
+      ->check(CLI::Range(1, 1000));
+  run->add_option("--alpha", options->alpha, "Keyframe rule 3: feature ratio to the reference")
+      ->check(CLI::Range(0.0, 1.0));
+  run->add_option("--beta", options->beta, "Keyframe rule 4: tracked ratio to the reference")
+      ->check(CLI::Range(0.0, 1.0));
   run->callback([options] { exitCode() = runPipeline(*options); });
 }
 

@@ -21,6 +21,11 @@ struct RunOptions {
   std::filesystem::path out_dir;
   int viewer_port = 0;
   std::optional<std::filesystem::path> camera_file;
+  // Tuning; unset values keep the defaults (Table I row 1 for local tracking).
+  std::optional<int> features;
+  std::optional<int> levels;
+  std::optional<int> fmin, fmax;
+  std::optional<double> alpha, beta;
 };
 
 }  // namespace edgeslam::cli

@@ -6,8 +6,8 @@ KeyFrameDecision decideKeyFrame(const KeyFrameParameters& params, const KeyFrame
   if (e.frame_tracked < static_cast<std::size_t>(params.min_tracked)) return KeyFrameDecision::kNo;
 
   const bool enough_features =
-      e.reference_features == 0 ||
-      static_cast<double>(e.frame_features) >= params.alpha * static_cast<double>(e.reference_features);
+      e.reference_features == 0 || static_cast<double>(e.frame_features) >=
+                                       params.alpha * static_cast<double>(e.reference_features);
   if (!enough_features) return KeyFrameDecision::kNo;
 
   const double tracked_ratio =

@@ -4,7 +4,8 @@
 //
 // The paper's rules, as implemented:
 //  (1) more than fmin frames since the last keyframe, or fewer than fmin keyframes in the map;
-//  (2) fewer than fmax frames since the last local-map optimisation (the edge's or the local mapper's
+//  (2) fewer than fmax frames since the last local-map optimisation (the edge's or the local
+//  mapper's
 //      latest update); past fmax a keyframe is forced so the map keeps up with the camera;
 //  (3) the frame has at least alpha times the reference keyframe's feature count (a good image);
 //  (4) the frame's tracked points are fewer than beta times the reference keyframe's tracked points
@@ -40,6 +41,8 @@ enum class KeyFrameDecision { kNo, kYes, kYesForced, kYesStarving };
 
 KeyFrameDecision decideKeyFrame(const KeyFrameParameters& params, const KeyFrameEvidence& evidence);
 
-inline bool isKeyFrame(KeyFrameDecision d) { return d != KeyFrameDecision::kNo; }
+inline bool isKeyFrame(KeyFrameDecision d) {
+  return d != KeyFrameDecision::kNo;
+}
 
 }  // namespace edgeslam

@@ -60,8 +60,8 @@ KeyFrame* MonocularInitializer::tryInitialize(Frame& frame, Map& map) {
   KeyFrame* kf1 = nullptr;
   {
     std::lock_guard lock(map.updateMutex());
-    kf0 = map.createKeyFrame(reference_->index, reference_->timestamp, reference_->features,
-                             SE3d());
+    kf0 =
+        map.createKeyFrame(reference_->index, reference_->timestamp, reference_->features, SE3d());
     kf1 = map.createKeyFrame(frame.index, frame.timestamp, frame.features,
                              two_view.current_from_reference);
     for (std::size_t i = 0; i < matches.size(); ++i) {
@@ -81,8 +81,8 @@ KeyFrame* MonocularInitializer::tryInitialize(Frame& frame, Map& map) {
   const double median_depth = kf0->medianSceneDepth();
   const int tracked = kf1->trackedPointCount(1);
   if (median_depth <= 0.0 || tracked < options_.min_map_points) {
-    last_failure_ = fmt::format("initial map too weak ({} points, median depth {:.3f})", tracked,
-                                median_depth);
+    last_failure_ =
+        fmt::format("initial map too weak ({} points, median depth {:.3f})", tracked, median_depth);
     map.clear();
     resetReference(frame);
     return nullptr;

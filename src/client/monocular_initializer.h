@@ -1,6 +1,7 @@
 #pragma once
-// Monocular map initialisation: keeps a reference frame, matches later frames to it and, once the two
-// views have enough parallax, builds the first two keyframes and their points (unit median depth).
+// Monocular map initialisation: keeps a reference frame, matches later frames to it and, once the
+// two views have enough parallax, builds the first two keyframes and their points (unit median
+// depth).
 #include <memory>
 #include <optional>
 
@@ -15,7 +16,7 @@ struct MonocularInitializerOptions {
   int min_features = 100;  // frames with fewer are not used
   int min_matches = 100;   // fewer matches to the reference: start again from the current frame
   float search_radius = 100.f;
-  int min_map_points = 100;  // after the initial BA; fewer means a bad start
+  int min_map_points = 100;            // after the initial BA; fewer means a bad start
   std::size_t max_reference_age = 30;  // frames; an old reference is replaced
   TwoViewOptions two_view;
 };
@@ -24,8 +25,8 @@ class MonocularInitializer {
  public:
   MonocularInitializer(const PinholeCamera& camera, MonocularInitializerOptions options = {});
 
-  // Tries to initialise from `frame`; on success the map holds two keyframes and `frame` has its pose
-  // and point matches set. Returns the second keyframe (the current frame's) or nullptr.
+  // Tries to initialise from `frame`; on success the map holds two keyframes and `frame` has its
+  // pose and point matches set. Returns the second keyframe (the current frame's) or nullptr.
   KeyFrame* tryInitialize(Frame& frame, Map& map);
   const std::string& lastFailure() const { return last_failure_; }
   int attempts() const { return attempts_; }

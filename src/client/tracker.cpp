@@ -13,9 +13,12 @@ namespace edgeslam {
 
 const char* toString(TrackingState state) {
   switch (state) {
-    case TrackingState::kNotInitialized: return "not initialised";
-    case TrackingState::kOk: return "ok";
-    case TrackingState::kLost: return "lost";
+    case TrackingState::kNotInitialized:
+      return "not initialised";
+    case TrackingState::kOk:
+      return "ok";
+    case TrackingState::kLost:
+      return "lost";
   }
   return "?";
 }
@@ -135,7 +138,10 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
 bool Tracker::initialize(Frame& frame) {
   if (options_.sensor != Sensor::kMonocular) return initializeRgbd(frame);
   KeyFrame* kf = mono_init_.tryInitialize(frame, map_);
-  if (kf == nullptr) return false;
+  if (kf == nullptr) {
+    spdlog::debug("frame {}: not initialised: {}", frame.index, mono_init_.lastFailure());
+    return false;
+  }
   std::lock_guard lock(map_.updateMutex());
   KeyFrame* kf0 = map_.originKeyFrame();
   spdlog::info("monocular map initialised at frame {} with {} points (reference frame {})",
@@ -237,8 +243,8 @@ bool Tracker::trackReferenceKeyFrame(Frame& frame) {
 }
 
 bool Tracker::relocalize(Frame& frame) {
-  // Without a place-recognition database yet, try the most recent keyframes and the last reference's
-  // neighbourhood.
+  // Without a place-recognition database yet, try the most recent keyframes and the last
+  // reference's neighbourhood.
   std::vector<KeyFrame*> candidates;
   const std::vector<KeyFrame*> all = map_.keyFrames();
   for (auto it = all.rbegin(); it != all.rend() && candidates.size() < 15; ++it) {
@@ -384,9 +390,9 @@ KeyFrameDecision Tracker::decide(const Frame& frame, int inliers) const {
   if (reference_keyframe_ == nullptr) return KeyFrameDecision::kNo;
   KeyFrameEvidence e;
   e.frames_since_keyframe = frame.index - last_keyframe_frame_;
-  e.frames_since_map_update =
-      sink_ != nullptr ? frame.index - std::min(frame.index, sink_->lastOptimizedFrame())
-                       : e.frames_since_keyframe;
+  e.frames_since_map_update = sink_ != nullptr
+                                  ? frame.index - std::min(frame.index, sink_->lastOptimizedFrame())
+                                  : e.frames_since_keyframe;
   e.keyframes_in_map = map_.keyFrameCount();
   e.frame_features = frame.size();
   e.reference_features = reference_keyframe_->size();
@@ -441,8 +447,8 @@ void Tracker::record(const Frame& frame, bool tracked) {
   r.tracked = tracked && frame.T_cw.has_value();
   if (r.tracked) {
     r.T_cw = *frame.T_cw;
-    r.reference = frame.reference_keyframe != nullptr ? frame.reference_keyframe
-                                                      : reference_keyframe_;
+    r.reference =
+        frame.reference_keyframe != nullptr ? frame.reference_keyframe : reference_keyframe_;
     if (r.reference != nullptr) r.T_cr = r.T_cw * r.reference->poseInverse();
   }
   records_.push_back(r);

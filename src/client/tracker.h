@@ -1,8 +1,9 @@
 #pragma once
-// Camera tracking against the map at frame rate: initialisation, constant-velocity motion model with
-// guided projection search, reference-keyframe fallback, local-map tracking, pose-only optimisation,
-// the keyframe decision and keyframe creation. One instance per camera; not thread-safe itself, but it
-// holds the map's update mutex while it reads or changes the map, so a mapper may run beside it.
+// Camera tracking against the map at frame rate: initialisation, constant-velocity motion model
+// with guided projection search, reference-keyframe fallback, local-map tracking, pose-only
+// optimisation, the keyframe decision and keyframe creation. One instance per camera; not
+// thread-safe itself, but it holds the map's update mutex while it reads or changes the map, so a
+// mapper may run beside it.
 #include <cstddef>
 #include <memory>
 #include <optional>

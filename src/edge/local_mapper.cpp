@@ -14,7 +14,9 @@ namespace edgeslam {
 LocalMapper::LocalMapper(Map& map, const PinholeCamera& camera, LocalMapperOptions options)
     : map_(map), camera_(camera), options_(options) {}
 
-LocalMapper::~LocalMapper() { stop(); }
+LocalMapper::~LocalMapper() {
+  stop();
+}
 
 void LocalMapper::start() {
   if (thread_.joinable()) return;
@@ -206,8 +208,10 @@ void LocalMapper::createNewPoints(KeyFrame* keyframe) {
       const double ray_cos = ray1.dot(ray2);
       const bool depth1 = f1.hasDepth(i1), depth2 = f2.hasDepth(i2);
       // Parallax a stereo/depth measurement would give, to decide between rays and depth.
-      const double depth_cos1 = depth1 ? std::cos(2 * std::atan2(f1.bf / camera_.fx() / 2, f1.depth[i1])) : 1.1;
-      const double depth_cos2 = depth2 ? std::cos(2 * std::atan2(f2.bf / camera_.fx() / 2, f2.depth[i2])) : 1.1;
+      const double depth_cos1 =
+          depth1 ? std::cos(2 * std::atan2(f1.bf / camera_.fx() / 2, f1.depth[i1])) : 1.1;
+      const double depth_cos2 =
+          depth2 ? std::cos(2 * std::atan2(f2.bf / camera_.fx() / 2, f2.depth[i2])) : 1.1;
       const double depth_cos = std::min(depth_cos1, depth_cos2);
 
       std::optional<Eigen::Vector3d> x;
@@ -222,10 +226,10 @@ void LocalMapper::createNewPoints(KeyFrame* keyframe) {
       if (!x || !x->allFinite()) continue;
       if (!isInFrontOfBoth(T1, T2, *x)) continue;
       // Reprojection in both keyframes, at each keypoint's level.
-      const double error1 = reprojectionErrorSquared(camera_, T1, *x, px1) *
-                          scales.invSigma2(kp1.octave);
-      const double error2 = reprojectionErrorSquared(camera_, T2, *x, px2) *
-                          f2.scales.invSigma2(kp2.octave);
+      const double error1 =
+          reprojectionErrorSquared(camera_, T1, *x, px1) * scales.invSigma2(kp1.octave);
+      const double error2 =
+          reprojectionErrorSquared(camera_, T2, *x, px2) * f2.scales.invSigma2(kp2.octave);
       if (error1 > chi2::k2Dof95 || error2 > chi2::k2Dof95) continue;
       // Scale consistency: distance ratio must agree with the pyramid level ratio.
       const double dist1 = (*x - c1).norm(), dist2 = (*x - c2).norm();

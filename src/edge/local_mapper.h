@@ -1,7 +1,8 @@
 #pragma once
-// Local mapping: takes keyframes from tracking and, on its own thread, links their points, culls weak
-// recent points, triangulates new points with neighbour keyframes, fuses duplicates, runs local bundle
-// adjustment and removes redundant keyframes. Every map change goes through Map under its mutex.
+// Local mapping: takes keyframes from tracking and, on its own thread, links their points, culls
+// weak recent points, triangulates new points with neighbour keyframes, fuses duplicates, runs
+// local bundle adjustment and removes redundant keyframes. Every map change goes through Map under
+// its mutex.
 #include <atomic>
 #include <condition_variable>
 #include <cstddef>
@@ -23,7 +24,7 @@ struct LocalMapperOptions {
   std::size_t triangulation_neighbours_depth = 10;
   std::size_t fusion_neighbours_mono = 20;
   std::size_t fusion_neighbours_depth = 10;
-  std::size_t max_queue = 3;  // tracking is asked to wait beyond this backlog
+  std::size_t max_queue = 3;     // tracking is asked to wait beyond this backlog
   double redundant_ratio = 0.9;  // a keyframe whose points are 90 % seen by 3+ others is culled
   bool run_local_ba = true;
   bool cull_keyframes = true;

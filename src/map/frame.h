@@ -1,5 +1,6 @@
 #pragma once
-// A frame being tracked: its features, its estimated pose and which map point each keypoint matched.
+// A frame being tracked: its features, its estimated pose and which map point each keypoint
+// matched.
 #include <memory>
 #include <optional>
 #include <vector>

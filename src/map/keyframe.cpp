@@ -97,7 +97,8 @@ void KeyFrame::updateConnections() {
   }
   if (counts.empty()) return;
 
-  // Edges need at least 15 shared points; keep the strongest one anyway so the graph stays connected.
+  // Edges need at least 15 shared points; keep the strongest one anyway so the graph stays
+  // connected.
   constexpr int kMinWeight = 15;
   KeyFrame* strongest = nullptr;
   int strongest_weight = 0;

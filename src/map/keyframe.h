@@ -1,13 +1,13 @@
 #pragma once
-// A keyframe: a frame's features kept in the map, its pose, the points it observes and its place in the
-// covisibility graph and spanning tree. Mutated only through Map (under its update mutex).
+// A keyframe: a frame's features kept in the map, its pose, the points it observes and its place in
+// the covisibility graph and spanning tree. Mutated only through Map (under its update mutex).
 #include <map>
 #include <memory>
 #include <set>
 #include <vector>
 
-#include "geometry/se3.h"
 #include "features/frame_features.h"
+#include "geometry/se3.h"
 #include "map/ids.h"
 
 namespace edgeslam {
@@ -48,7 +48,9 @@ class KeyFrame {
   double medianSceneDepth() const;
 
   // Covisibility: keyframes sharing points, with the number of shared points as weight.
-  const std::map<KeyFrame*, int, KeyFrameIdLess>& connections() const { return connection_weights_; }
+  const std::map<KeyFrame*, int, KeyFrameIdLess>& connections() const {
+    return connection_weights_;
+  }
   std::vector<KeyFrame*> bestCovisibles(std::size_t n) const;
   std::vector<KeyFrame*> covisiblesWithWeightAtLeast(int weight) const;
   int weight(KeyFrame* other) const;

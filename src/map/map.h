@@ -1,10 +1,11 @@
 #pragma once
-// The map: owns keyframes and points by id and is the single place where they change, so every change
-// is recorded (MapChanges) for the slices that keep client and edge in step.
+// The map: owns keyframes and points by id and is the single place where they change, so every
+// change is recorded (MapChanges) for the slices that keep client and edge in step.
 //
-// Thread safety: callers hold updateMutex() around any sequence of calls that reads or changes the map
-// from more than one thread (tracking holds it for a frame; mapping for each change it applies).
-// Erased elements stay allocated until the Map is destroyed, so raw pointers never dangle.
+// Thread safety: callers hold updateMutex() around any sequence of calls that reads or changes the
+// map from more than one thread (tracking holds it for a frame; mapping for each change it
+// applies). Erased elements stay allocated until the Map is destroyed, so raw pointers never
+// dangle.
 #include <memory>
 #include <mutex>
 #include <unordered_map>
@@ -44,7 +45,8 @@ class Map {
 
   void setKeyFramePose(KeyFrame* keyframe, const SE3d& T_cw);
   void updateConnections(KeyFrame* keyframe);
-  // Removes a redundant keyframe: unlinks its observations and re-parents its spanning-tree children.
+  // Removes a redundant keyframe: unlinks its observations and re-parents its spanning-tree
+  // children.
   void eraseKeyFrame(KeyFrame* keyframe);
   void addLoopEdge(KeyFrame* a, KeyFrame* b);
   // Empties the map (a failed start); ids keep counting up.

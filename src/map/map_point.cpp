@@ -40,8 +40,8 @@ void MapPoint::updateNormalAndDepth() {
   const float distance =
       static_cast<float>((position_ - reference_keyframe_->cameraCenter()).norm());
   max_distance_ = distance * static_cast<float>(features.scales.scale(level));
-  min_distance_ = max_distance_ / static_cast<float>(
-                                      features.scales.scale(features.scales.numLevels() - 1));
+  min_distance_ =
+      max_distance_ / static_cast<float>(features.scales.scale(features.scales.numLevels() - 1));
 }
 
 void MapPoint::computeDistinctiveDescriptor() {

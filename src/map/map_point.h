@@ -1,6 +1,7 @@
 #pragma once
-// A 3-D landmark: position, viewing direction, representative descriptor, scale range, observations.
-// Mutated only through Map (under its update mutex) so that every change can be recorded.
+// A 3-D landmark: position, viewing direction, representative descriptor, scale range,
+// observations. Mutated only through Map (under its update mutex) so that every change can be
+// recorded.
 #include <Eigen/Core>
 #include <map>
 #include <memory>

@@ -55,8 +55,7 @@ ProblemBuild buildProblem(const std::vector<KeyFrame*>& free_keyframes, KeyFrame
       const FrameFeatures& f = kf->features();
       const cv::KeyPoint& kp = f.keypoints[obs.index];
       build.problem.observations.push_back({ki, pi, Eigen::Vector2d(kp.pt.x, kp.pt.y),
-                                            rightU(f, obs.index),
-                                            f.scales.invSigma2(kp.octave)});
+                                            rightU(f, obs.index), f.scales.invSigma2(kp.octave)});
       build.observation_owners.emplace_back(kf, p);
     }
   }
@@ -69,7 +68,8 @@ ProblemBuild buildProblem(const std::vector<KeyFrame*>& free_keyframes, KeyFrame
 LocalBundleAdjustmentStats solveAndApply(Map& map, ProblemBuild build,
                                          const BundleAdjustmentOptions& options) {
   LocalBundleAdjustmentStats stats;
-  for (const auto& kf : build.problem.keyframes) (kf.fixed ? stats.fixed_keyframes : stats.keyframes)++;
+  for (const auto& kf : build.problem.keyframes)
+    (kf.fixed ? stats.fixed_keyframes : stats.keyframes)++;
   stats.points = build.points.size();
   stats.observations = build.problem.observations.size();
   if (stats.keyframes == 0 || stats.points == 0) return stats;
@@ -145,8 +145,7 @@ LocalBundleAdjustmentStats localBundleAdjustment(Map& map, KeyFrame* keyframe,
 }
 
 LocalBundleAdjustmentStats globalBundleAdjustment(Map& map, const PinholeCamera& camera,
-                                                  const std::atomic<bool>* cancel,
-                                                  int iterations) {
+                                                  const std::atomic<bool>* cancel, int iterations) {
   ProblemBuild build;
   {
     std::lock_guard lock(map.updateMutex());

@@ -7,6 +7,11 @@ LocalSlamOptions defaultLocalSlamOptions(const PinholeCamera& camera, Sensor sen
   options.sensor = sensor;
   options.orb.num_features = camera.width() * camera.height() > 640 * 480 * 1.2 ? 2000 : 1000;
   options.tracker.sensor = sensor;
+  // No network between tracking and mapping: N = 0, paper Table I row 1.
+  options.tracker.keyframes.fmin = 10;
+  options.tracker.keyframes.fmax = 40;
+  options.tracker.keyframes.alpha = 0.3;
+  options.tracker.keyframes.beta = 0.9;
   options.mapper.monocular = sensor == Sensor::kMonocular;
   return options;
 }
@@ -20,7 +25,9 @@ LocalSlam::LocalSlam(const PinholeCamera& camera, LocalSlamOptions options)
   if (options_.threaded_mapping) mapper_->start();
 }
 
-LocalSlam::~LocalSlam() { mapper_->stop(); }
+LocalSlam::~LocalSlam() {
+  mapper_->stop();
+}
 
 TrackResult LocalSlam::process(std::size_t frame_index, double timestamp, const cv::Mat& gray,
                                const cv::Mat& depth) {
@@ -31,7 +38,9 @@ TrackResult LocalSlam::process(std::size_t frame_index, double timestamp, const 
   return result;
 }
 
-void LocalSlam::finish() { mapper_->waitUntilIdle(); }
+void LocalSlam::finish() {
+  mapper_->waitUntilIdle();
+}
 
 Trajectory LocalSlam::trajectoryAtFrameTime() const {
   Trajectory out;

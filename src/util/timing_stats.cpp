@@ -26,7 +26,8 @@ PercentileSummary SampleStats::summary() const {
     const double position = q * static_cast<double>(sorted.size() - 1);
     const auto lower = static_cast<std::size_t>(std::floor(position));
     const std::size_t upper = std::min(lower + 1, sorted.size() - 1);
-    return sorted[lower] + (position - static_cast<double>(lower)) * (sorted[upper] - sorted[lower]);
+    return sorted[lower] +
+           (position - static_cast<double>(lower)) * (sorted[upper] - sorted[lower]);
   };
   s.median = at(0.5);
   s.p90 = at(0.9);

@@ -1,5 +1,6 @@
 #pragma once
-// Collects durations (or any samples) and reports median / p90 / p99 / max as DESIGN.md's metrics ask.
+// Collects durations (or any samples) and reports median / p90 / p99 / max as DESIGN.md's metrics
+// ask.
 #include <chrono>
 #include <cstddef>
 #include <vector>

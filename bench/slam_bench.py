@@ -1,0 +1,99 @@
+#!/usr/bin/env python3
+"""SLAM accuracy/speed benchmark: the issue's reference rows, each run N times, pinned to one core.
+
+Prints a markdown table (median of the runs and [min-max] spread) and writes it to docs/benchmarks.md
+(between the SLAM markers) unless --no-docs. Usage:
+  bench/slam_bench.py [--build build] [--runs 3] [--shared ../shared] [--rows mono,rgbd,kitti] [--mode local]
+"""
+import argparse
+import json
+import os
+import re
+import statistics
+import subprocess
+import sys
+import tempfile
+
+ROWS = {
+    "mono": ("7-Scenes redkitchen 1000", "datasets/7scenes-redkitchen-1000", "mono",
+             "4.40 cm [4.32-4.43]", "28.8 / 35.2"),
+    "rgbd": ("7-Scenes redkitchen 1000", "datasets/7scenes-redkitchen-1000", "rgbd",
+             "4.75 cm [4.67-4.84]", "30.9 / 40.3"),
+    "kitti": ("KITTI 07 0-159", "datasets/kitti07-160", "mono", "29.98 cm [28.06-32.12]",
+              "30.3 / 41.0"),
+}
+
+
+def run_once(binary, dataset, sensor, mode, cpu):
+    with tempfile.TemporaryDirectory() as out:
+        cmd = [binary, "run", "--dataset", dataset, "--sensor", sensor, "--mode", mode, "--out", out]
+        if cpu is not None:
+            cmd = ["taskset", "-c", str(cpu)] + cmd
+        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        with open(os.path.join(out, "metrics.json")) as f:
+            return json.load(f)
+
+
+def spread(values, fmt):
+    return f"{fmt(statistics.median(values))} [{fmt(min(values))}-{fmt(max(values))}]"
+
+
+def main():
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    parser = argparse.ArgumentParser()
+    parser.add_argument("--build", default=os.path.join(root, "build"))
+    parser.add_argument("--runs", type=int, default=3)
+    parser.add_argument("--shared", default=os.environ.get("EDGESLAM_SHARED",
+                                                           os.path.join(root, "..", "shared")))
+    parser.add_argument("--rows", default="mono,rgbd,kitti")
+    parser.add_argument("--mode", default="local")
+    parser.add_argument("--cpu", default="0", help="core to pin to; 'none' for no pinning")
+    parser.add_argument("--no-docs", action="store_true")
+    args = parser.parse_args()
+    binary = os.path.join(args.build, "edgeslam")
+    cpu = None if args.cpu == "none" else int(args.cpu)
+
+    lines = ["| sequence | sensor | mode | tracked | frames before init | ATE final RMSE, cm (median [min-max]) "
+             "| ATE at frame time, cm | client ms median / p90 / p99 | ORB-SLAM2 ATE | ORB-SLAM2 ms median / p90 |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    for key in args.rows.split(","):
+        name, rel, sensor, ref_ate, ref_ms = ROWS[key]
+        dataset = os.path.join(args.shared, rel)
+        if not os.path.isdir(dataset):
+            print(f"skip {key}: {dataset} not found", file=sys.stderr)
+            continue
+        runs = []
+        for i in range(args.runs):
+            print(f"{key}: run {i + 1}/{args.runs}", file=sys.stderr, flush=True)
+            runs.append(run_once(binary, dataset, sensor, args.mode, cpu))
+        ate = [100 * r["ate_final"]["rmse_m"] for r in runs if "ate_final" in r]
+        ate_t = [100 * r["ate"]["rmse_m"] for r in runs if "ate" in r]
+        tracked = [r["tracked"] for r in runs]
+        init = [r["frames"] - r["tracked"] - r["lost"] for r in runs]
+        med = [r["client_ms"]["median"] for r in runs]
+        p90 = [r["client_ms"]["p90"] for r in runs]
+        p99 = [r["client_ms"]["p99"] for r in runs]
+        f2 = lambda v: f"{v:.2f}"
+        f1 = lambda v: f"{v:.1f}"
+        lines.append(
+            f"| {name} | {sensor} | {args.mode} | {statistics.median(tracked):.0f}/{runs[0]['frames']} "
+            f"| {statistics.median(init):.0f} | {spread(ate, f2) if ate else '-'} "
+            f"| {spread(ate_t, f2) if ate_t else '-'} "
+            f"| {f1(statistics.median(med))} / {f1(statistics.median(p90))} / {f1(statistics.median(p99))} "
+            f"| {ref_ate} | {ref_ms} |")
+    table = "\n".join(lines)
+    print(table)
+    if not args.no_docs:
+        path = os.path.join(root, "docs", "benchmarks.md")
+        text = open(path).read() if os.path.exists(path) else "# Benchmarks\n"
+        block = f"<!-- slam-bench -->\n{table}\n<!-- /slam-bench -->"
+        if "<!-- slam-bench -->" in text:
+            text = re.sub(r"<!-- slam-bench -->.*?<!-- /slam-bench -->", block, text, flags=re.S)
+        else:
+            text += "\n" + block + "\n"
+        with open(path, "w") as f:
+            f.write(text)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,80 @@
+#include "client/keyframe_policy.h"
+
+#include <gtest/gtest.h>
+
+namespace edgeslam {
+namespace {
+
+KeyFrameEvidence healthy() {
+  KeyFrameEvidence e;
+  e.frames_since_keyframe = 5;
+  e.frames_since_map_update = 5;
+  e.keyframes_in_map = 50;
+  e.frame_features = 1000;
+  e.reference_features = 1000;
+  e.frame_tracked = 300;
+  e.reference_tracked = 320;
+  return e;
+}
+
+TEST(KeyFramePolicy, NoKeyFrameWhileTheViewIsUnchanged) {
+  EXPECT_EQ(decideKeyFrame({}, healthy()), KeyFrameDecision::kNo);
+}
+
+TEST(KeyFramePolicy, Rule1And4MakeAKeyFrame) {
+  KeyFrameParameters p;  // fmin 20, beta 0.9
+  KeyFrameEvidence e = healthy();
+  e.frames_since_keyframe = 21;
+  e.frame_tracked = 250;  // 250 / 320 < 0.9
+  EXPECT_EQ(decideKeyFrame(p, e), KeyFrameDecision::kYes);
+  e.frames_since_keyframe = 20;  // "more than fmin" is strict
+  EXPECT_EQ(decideKeyFrame(p, e), KeyFrameDecision::kNo);
+}
+
+TEST(KeyFramePolicy, FewKeyFramesInTheMapWaiveFmin) {
+  KeyFrameEvidence e = healthy();
+  e.keyframes_in_map = 3;
+  e.frame_tracked = 250;
+  EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kYes);
+}
+
+TEST(KeyFramePolicy, Rule2ForcesAKeyFrameAfterFmax) {
+  KeyFrameEvidence e = healthy();
+  e.frames_since_map_update = 60;
+  EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kYesForced);
+}
+
+TEST(KeyFramePolicy, Rule3RejectsPoorImages) {
+  KeyFrameEvidence e = healthy();
+  e.frames_since_map_update = 100;
+  e.frame_features = 300;  // < 0.4 * 1000
+  EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kNo);
+}
+
+TEST(KeyFramePolicy, StarvingTrackingWaivesFmin) {
+  KeyFrameEvidence e = healthy();
+  e.frame_tracked = 80;  // 80 / 320 = 0.25 < 0.35
+  EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kYesStarving);
+  e.mapper_accepts = false;
+  EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kNo);
+}
+
+TEST(KeyFramePolicy, NeverFromABarelyTrackedFrame) {
+  KeyFrameEvidence e = healthy();
+  e.frame_tracked = 10;
+  e.frames_since_map_update = 1000;
+  EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kNo);
+}
+
+TEST(KeyFramePolicy, TableIRowsChangeTheDecision) {
+  KeyFrameEvidence e = healthy();
+  e.frames_since_keyframe = 15;
+  e.frame_tracked = 250;
+  KeyFrameParameters fast_link{10, 40, 0.3, 0.9};
+  KeyFrameParameters slow_link{40, 80, 0.5, 0.7};
+  EXPECT_EQ(decideKeyFrame(fast_link, e), KeyFrameDecision::kYes);
+  EXPECT_EQ(decideKeyFrame(slow_link, e), KeyFrameDecision::kNo);
+}
+
+}  // namespace
+}  // namespace edgeslam
