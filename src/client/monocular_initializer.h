@@ -18,7 +18,13 @@ struct MonocularInitializerOptions {
   float search_radius = 100.f;
   int min_map_points = 100;            // after the initial BA; fewer means a bad start
   std::size_t max_reference_age = 30;  // frames; an old reference is replaced
-  TwoViewOptions two_view;
+  // A first map from a short baseline with few points is fragile: ask for 150 well-triangulated
+  // points (the two-view default is 50).
+  TwoViewOptions two_view = [] {
+    TwoViewOptions o;
+    o.min_triangulated = 150;
+    return o;
+  }();
 };
 
 class MonocularInitializer {

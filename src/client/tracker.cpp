@@ -82,6 +82,7 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
       inliers = trackLocalMap(frame);
       const bool recently_relocalized =
           relocalizations_ > 0 && frame_index < last_relocalization_frame_ + 30;
+      spdlog::debug("frame {}: local map inliers {}", frame_index, inliers);
       ok = inliers >= (recently_relocalized ? options_.min_inliers_local_map_after_relocalization
                                             : options_.min_inliers_local_map);
     }
@@ -227,15 +228,21 @@ bool Tracker::trackWithMotionModel(Frame& frame) {
     std::fill(frame.points.begin(), frame.points.end(), nullptr);
     matches = matchByProjection(frame, last, 2.f * radius, mono);
   }
-  if (matches < 20) return false;
+  if (matches < 20) {
+    spdlog::debug("frame {}: motion model found {} matches", frame.index, matches);
+    return false;
+  }
   optimizeFramePose(frame);
-  return discardOutliers(frame) >= options_.min_inliers_motion;
+  const int inliers = discardOutliers(frame);
+  spdlog::debug("frame {}: motion model {} matches, {} inliers", frame.index, matches, inliers);
+  return inliers >= options_.min_inliers_motion;
 }
 
 bool Tracker::trackReferenceKeyFrame(Frame& frame) {
   if (reference_keyframe_ == nullptr || reference_keyframe_->isBad() || !last_frame_) return false;
   std::fill(frame.points.begin(), frame.points.end(), nullptr);
   const int matches = matchKeyFrameByDescriptor(*reference_keyframe_, frame);
+  spdlog::debug("frame {}: reference keyframe matches {}", frame.index, matches);
   if (matches < 15) return false;
   frame.T_cw = last_frame_->T_cw ? *last_frame_->T_cw : reference_keyframe_->pose();
   optimizeFramePose(frame);
@@ -400,7 +407,14 @@ KeyFrameDecision Tracker::decide(const Frame& frame, int inliers) const {
   const int min_obs = e.keyframes_in_map <= 2 ? 2 : 3;
   e.reference_tracked = static_cast<std::size_t>(reference_keyframe_->trackedPointCount(min_obs));
   e.mapper_accepts = sink_ == nullptr || sink_->acceptsKeyFrames();
-  return decideKeyFrame(options_.keyframes, e);
+  const KeyFrameDecision decision = decideKeyFrame(options_.keyframes, e);
+  spdlog::debug(
+      "frame {}: keyframe decision {} (since kf {}, since map update {}, kfs {}, features {}/{}, "
+      "tracked {}/{}, mapper {})",
+      frame.index, static_cast<int>(decision), e.frames_since_keyframe, e.frames_since_map_update,
+      e.keyframes_in_map, e.frame_features, e.reference_features, e.frame_tracked,
+      e.reference_tracked, e.mapper_accepts ? "accepts" : "busy");
+  return decision;
 }
 
 KeyFrame* Tracker::createKeyFrame(Frame& frame) {

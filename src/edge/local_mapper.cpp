@@ -196,7 +196,8 @@ void LocalMapper::createNewPoints(KeyFrame* keyframe) {
     } else if (f1.bf > 0.f && baseline < f1.bf / camera_.fx()) {
       continue;
     }
-    const auto pairs = matchForTriangulation(*keyframe, *neighbour, camera_, mono);
+    const auto pairs =
+        matchForTriangulation(*keyframe, *neighbour, camera_, mono, options_.triangulation_ratio);
     const FrameFeatures& f2 = neighbour->features();
     for (const auto& [i1, i2] : pairs) {
       if (keyframe->point(i1) != nullptr || neighbour->point(i2) != nullptr) continue;
@@ -247,6 +248,8 @@ void LocalMapper::createNewPoints(KeyFrame* keyframe) {
       ++created;
     }
   }
+  spdlog::debug("keyframe {} (frame {}): {} new points from {} neighbours", keyframe->id(),
+                keyframe->frameIndex(), created, neighbours.size());
   std::lock_guard lock(stats_mutex_);
   stats_.points_created += created;
 }

@@ -24,6 +24,8 @@ struct LocalMapperOptions {
   std::size_t triangulation_neighbours_depth = 10;
   std::size_t fusion_neighbours_mono = 20;
   std::size_t fusion_neighbours_depth = 10;
+  // Best/second-best ratio of the epipolar descriptor search.
+  float triangulation_ratio = 0.6f;
   std::size_t max_queue = 3;     // tracking is asked to wait beyond this backlog
   double redundant_ratio = 0.9;  // a keyframe whose points are 90 % seen by 3+ others is culled
   bool run_local_ba = true;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <future>
 #include <numbers>
 #include <stdexcept>
@@ -69,13 +70,14 @@ struct Hypothesis {
   std::vector<char> good_flags;
   std::vector<double> parallax_deg;  // per match, valid where good
   double median_inlier_parallax_deg = 0.0;
+  double ranked_inlier_parallax_deg = 0.0;  // the parallax_rank-th largest
 };
 
 Hypothesis evaluate(const SE3d& cur_from_ref, std::span<const Eigen::Vector2d> ref_px,
                     std::span<const Eigen::Vector2d> cur_px,
                     const std::vector<Eigen::Vector2d>& ref_n,
                     const std::vector<Eigen::Vector2d>& cur_n, const std::vector<char>& inliers,
-                    const Eigen::Matrix3d& K, double sigma_px) {
+                    const Eigen::Matrix3d& K, double sigma_px, int parallax_rank) {
   const size_t n = ref_px.size();
   Hypothesis h;
   h.cur_from_ref = cur_from_ref;
@@ -107,6 +109,14 @@ Hypothesis evaluate(const SE3d& cur_from_ref, std::span<const Eigen::Vector2d> r
     h.good_flags[i] = 1;
     h.parallax_deg[i] = parallaxDegrees(parallaxCosine(identity, cur_from_ref, *X));
     ++h.good;
+  }
+  if (!inlier_parallax.empty()) {
+    const auto rank =
+        std::min(inlier_parallax.size(), static_cast<size_t>(std::max(parallax_rank, 1))) - 1;
+    std::vector<double> sorted = inlier_parallax;
+    std::nth_element(sorted.begin(), sorted.begin() + static_cast<long>(rank), sorted.end(),
+                     std::greater<>());
+    h.ranked_inlier_parallax_deg = sorted[rank];
   }
   h.median_inlier_parallax_deg = median(std::move(inlier_parallax));
   return h;
@@ -189,7 +199,8 @@ TwoViewResult reconstruct(TwoViewResult result, TwoViewModel model, const Homogr
   hypotheses.reserve(motions.size());
   for (const SE3d& motion : motions) {
     hypotheses.push_back(evaluate(motion, in.ref_px, in.cur_px, in.ref_n, in.cur_n,
-                                  result.model_inliers, in.K, options.sigma_px));
+                                  result.model_inliers, in.K, options.sigma_px,
+                                  options.parallax_rank));
     result.candidate_good.push_back(hypotheses.back().good);
   }
   std::vector<int> order(hypotheses.size());
@@ -200,6 +211,7 @@ TwoViewResult reconstruct(TwoViewResult result, TwoViewModel model, const Homogr
   result.best_good = best.good;
   result.second_best_good = order.size() > 1 ? hypotheses[order[1]].good : 0;
   result.median_parallax_deg = best.median_inlier_parallax_deg;
+  result.ranked_parallax_deg = best.ranked_inlier_parallax_deg;
 
   auto count_triangulated = [&](const Hypothesis& hyp) {
     int count = 0;
@@ -209,11 +221,13 @@ TwoViewResult reconstruct(TwoViewResult result, TwoViewModel model, const Homogr
     return count;
   };
 
-  if (result.median_parallax_deg < options.min_parallax_deg) {
-    return fail(std::move(result), TwoViewFailure::kLowParallax,
-                fmt::format("median parallax {:.2f} deg < {:.2f} deg ({}): pure rotation or too "
-                            "little translation",
-                            result.median_parallax_deg, options.min_parallax_deg, toString(model)));
+  if (result.ranked_parallax_deg < options.min_parallax_deg) {
+    return fail(
+        std::move(result), TwoViewFailure::kLowParallax,
+        fmt::format("fewer than {} inliers with parallax >= {:.2f} deg (the {}th largest is "
+                    "{:.2f} deg, median {:.2f}) ({}): pure rotation or too little translation",
+                    options.parallax_rank, options.min_parallax_deg, options.parallax_rank,
+                    result.ranked_parallax_deg, result.median_parallax_deg, toString(model)));
   }
   if (const int count = count_triangulated(best); count < options.min_triangulated) {
     return fail(std::move(result), TwoViewFailure::kTooFewTriangulated,
@@ -264,7 +278,7 @@ TwoViewResult reconstruct(TwoViewResult result, TwoViewModel model, const Homogr
       }
     }
     Hypothesis again = evaluate(refined, in.ref_px, in.cur_px, in.ref_n, in.cur_n, refined_inliers,
-                                in.K, options.sigma_px);
+                                in.K, options.sigma_px, options.parallax_rank);
     if (stayed_close && again.good >= kMinRefinedGoodRatio * best.good) {
       best = std::move(again);
       result.model_inliers = std::move(refined_inliers);

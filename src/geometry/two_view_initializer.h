@@ -32,7 +32,10 @@ struct TwoViewOptions {
   double sigma_px = 1.0;                     // keypoint position noise (std. dev.)
   double homography_ratio_threshold = 0.45;  // choose H when S_H / (S_H + S_F) > this
   int min_triangulated = 50;
-  double min_parallax_deg = 1.0;        // median over the model's inliers
+  // Enough parallax = at least `parallax_rank` model inliers see the point under min_parallax_deg
+  // or more (a median would refuse forward motion, where most points are far and few are close).
+  double min_parallax_deg = 1.0;
+  int parallax_rank = 50;
   double min_point_parallax_deg = 0.5;  // below it a point is not flagged triangulated
   double max_second_best_ratio = 0.7;   // second-best good count / best good count
   double min_good_fraction = 0.8;       // best good count / model inliers
@@ -70,6 +73,7 @@ struct TwoViewResult {
   int best_good = 0;
   int second_best_good = 0;
   double median_parallax_deg = 0.0;
+  double ranked_parallax_deg = 0.0;  // the parallax_rank-th largest inlier parallax
 };
 
 // reference_px / current_px: matched undistorted pixels (same length); K: shared calibration.

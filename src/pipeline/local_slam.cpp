@@ -1,5 +1,8 @@
 #include "pipeline/local_slam.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace edgeslam {
 
 LocalSlamOptions defaultLocalSlamOptions(const PinholeCamera& camera, Sensor sensor) {
@@ -7,9 +10,12 @@ LocalSlamOptions defaultLocalSlamOptions(const PinholeCamera& camera, Sensor sen
   options.sensor = sensor;
   options.orb.num_features = camera.width() * camera.height() > 640 * 480 * 1.2 ? 2000 : 1000;
   options.tracker.sensor = sensor;
-  // No network between tracking and mapping: N = 0, paper Table I row 1.
-  options.tracker.keyframes.fmin = 10;
-  options.tracker.keyframes.fmax = 40;
+  // No network between tracking and mapping: N = 0, paper Table I row 1. The table counts frames
+  // of a 30 fps camera; a slower camera moves further per frame, so the counts shrink with it.
+  const double rate =
+      camera.intrinsics().fps > 0 ? std::min(1.0, camera.intrinsics().fps / 30.0) : 1.0;
+  options.tracker.keyframes.fmin = static_cast<int>(std::lround(10 * rate));
+  options.tracker.keyframes.fmax = std::max(1, static_cast<int>(std::lround(40 * rate)));
   options.tracker.keyframes.alpha = 0.3;
   options.tracker.keyframes.beta = 0.9;
   options.mapper.monocular = sensor == Sensor::kMonocular;

@@ -40,12 +40,13 @@ std::filesystem::path freshDir(const std::string& name) {
 TEST(RunCommand, WritesTheContractOutputs) {
   EDGESLAM_REQUIRE_SHARED("datasets/7scenes-redkitchen-1000");
   const auto out = freshDir("outputs");
-  const auto r = runCommand("run --dataset " +
-                            test::sharedPath("datasets/7scenes-redkitchen-1000").string() +
-                            " --sensor rgbd --mode local --max-frames 40 --out " + out.string());
+  const auto r =
+      runCommand("run --dataset " + test::sharedPath("datasets/7scenes-redkitchen-1000").string() +
+                 " --sensor rgbd --mode local --max-frames 40 --out " + out.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("Summary"), std::string::npos);
-  for (const char* file : {"trajectory.tum", "trajectory_final.tum", "keyframes.tum", "metrics.json"}) {
+  for (const char* file :
+       {"trajectory.tum", "trajectory_final.tum", "keyframes.tum", "metrics.json"}) {
     EXPECT_TRUE(std::filesystem::exists(out / file)) << file;
   }
   EXPECT_EQ(readTumTrajectory(out / "trajectory.tum").size(), 40u);
