@@ -51,7 +51,8 @@ bool LocalMapper::acceptsKeyFrames() const {
 void LocalMapper::onMapReset() {
   std::lock_guard lock(queue_mutex_);
   queue_.clear();
-  recent_points_.clear();
+  // recent_points_ belongs to the mapping thread: it drops them before its next keyframe.
+  reset_requested_ = true;
 }
 
 bool LocalMapper::hasPending() const {
@@ -106,6 +107,7 @@ void LocalMapper::run() {
 }
 
 void LocalMapper::processKeyFrame(KeyFrame* keyframe) {
+  if (reset_requested_.exchange(false)) recent_points_.clear();
   {
     std::lock_guard lock(map_.updateMutex());
     if (keyframe->isBad()) return;

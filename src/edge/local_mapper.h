@@ -81,6 +81,7 @@ class LocalMapper : public KeyFrameSink {
   std::thread thread_;
 
   std::atomic<bool> abort_ba_{false};
+  std::atomic<bool> reset_requested_{false};
   std::atomic<std::size_t> last_optimized_frame_{0};
   std::list<MapPoint*> recent_points_;
   mutable std::mutex stats_mutex_;
