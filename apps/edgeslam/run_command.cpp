@@ -89,6 +89,7 @@ int runPipeline(const RunOptions& options) {
   if (options.fmax) kf.fmax = *options.fmax;
   if (options.alpha) kf.alpha = *options.alpha;
   if (options.beta) kf.beta = *options.beta;
+  if (options.starving) kf.starving_ratio = *options.starving;
   slam_options.orb.validate();
   spdlog::info("{} ORB features, {} levels; keyframes fmin {} fmax {} alpha {} beta {}",
                slam_options.orb.num_features, slam_options.orb.num_levels, kf.fmin, kf.fmax,
@@ -232,6 +233,9 @@ void addRunCommand(CLI::App& app) {
   run->add_option("--alpha", options->alpha, "Keyframe rule 3: feature ratio to the reference")
       ->check(CLI::Range(0.0, 1.0));
   run->add_option("--beta", options->beta, "Keyframe rule 4: tracked ratio to the reference")
+      ->check(CLI::Range(0.0, 1.0));
+  run->add_option("--starving", options->starving,
+                  "Tracked ratio below which keyframe rule 1 is waived (tracking starves)")
       ->check(CLI::Range(0.0, 1.0));
   run->callback([options] { exitCode() = runPipeline(*options); });
 }

@@ -25,7 +25,7 @@ struct RunOptions {
   std::optional<int> features;
   std::optional<int> levels;
   std::optional<int> fmin, fmax;
-  std::optional<double> alpha, beta;
+  std::optional<double> alpha, beta, starving;
 };
 
 }  // namespace edgeslam::cli
