@@ -148,7 +148,6 @@ bool Tracker::initialize(Frame& frame) {
   spdlog::info("monocular map initialised at frame {} with {} points (reference frame {})",
                frame.index, map_.pointCount(), kf0->frameIndex());
   reference_keyframe_ = kf;
-  last_keyframe_ = kf;
   last_keyframe_frame_ = frame.index;
   frame.reference_keyframe = kf;
   // The reference frame's own record gets its pose now that the map exists.
@@ -194,7 +193,6 @@ bool Tracker::initializeRgbd(Frame& frame) {
                  map_.pointCount());
   }
   reference_keyframe_ = kf;
-  last_keyframe_ = kf;
   last_keyframe_frame_ = frame.index;
   frame.reference_keyframe = kf;
   if (sink_ != nullptr) sink_->insertKeyFrame(kf);
@@ -448,7 +446,6 @@ KeyFrame* Tracker::createKeyFrame(Frame& frame) {
   for (MapPoint* p : kf->goodPoints()) map_.refreshPoint(p);
   map_.updateConnections(kf);
   reference_keyframe_ = kf;
-  last_keyframe_ = kf;
   last_keyframe_frame_ = frame.index;
   frame.reference_keyframe = kf;
   return kf;
@@ -479,7 +476,6 @@ void Tracker::resetMap() {
   last_frame_.reset();
   velocity_.reset();
   reference_keyframe_ = nullptr;
-  last_keyframe_ = nullptr;
   local_keyframes_.clear();
   local_points_.clear();
   frames_lost_ = 0;

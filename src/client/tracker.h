@@ -81,7 +81,6 @@ class Tracker {
   std::optional<Frame> last_frame_;
   std::optional<SE3d> velocity_;  // T_cw(current) * T_wc(last)
   KeyFrame* reference_keyframe_ = nullptr;
-  KeyFrame* last_keyframe_ = nullptr;
   std::size_t last_keyframe_frame_ = 0;
   std::size_t last_relocalization_frame_ = 0;
   std::vector<KeyFrame*> local_keyframes_;

@@ -63,9 +63,6 @@ class KeyFrame {
 
   // Tracking / mapping scratch state.
   std::size_t track_reference_for_frame = static_cast<std::size_t>(-1);
-  std::size_t relocalization_query_frame = static_cast<std::size_t>(-1);
-  KeyFrameId local_ba_for = kInvalidId;
-  KeyFrameId fixed_ba_for = kInvalidId;
   KeyFrameId fuse_target_for = kInvalidId;
 
  private:

@@ -55,7 +55,6 @@ class MapPoint {
   bool track_in_view = false;
   // Local-mapping scratch state.
   KeyFrameId fuse_candidate_for = kInvalidId;
-  KeyFrameId local_ba_for = kInvalidId;
 
  private:
   friend class Map;

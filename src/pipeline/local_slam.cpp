@@ -10,11 +10,12 @@ LocalSlamOptions defaultLocalSlamOptions(const PinholeCamera& camera, Sensor sen
   options.sensor = sensor;
   options.orb.num_features = camera.width() * camera.height() > 640 * 480 * 1.2 ? 2000 : 1000;
   options.tracker.sensor = sensor;
-  // No network between tracking and mapping: N = 0, below paper Table I's first row (0, 10] ms, whose
-  // values we take. The table counts frames of a 30 fps camera, so the counts shrink with a slower
-  // camera; below 15 fps rule 1 is dropped altogether: consecutive frames are then already far apart
-  // (KITTI at 10 fps drives ~1 m per frame) and a minimum gap starves monocular tracking (KITTI 07:
-  // ATE 39 cm with fmin 3, 22-26 cm with fmin 0; 7-Scenes at 30 fps is best with fmin 10).
+  // No network between tracking and mapping: N = 0, below paper Table I's first row (0, 10] ms,
+  // whose values we take. The table counts frames of a 30 fps camera, so the counts shrink with a
+  // slower camera; below 15 fps rule 1 is dropped altogether: consecutive frames are then already
+  // far apart (KITTI at 10 fps drives ~1 m per frame) and a minimum gap starves monocular tracking
+  // (KITTI 07: ATE 39 cm with fmin 3, 22-26 cm with fmin 0; 7-Scenes at 30 fps is best with fmin
+  // 10).
   const double rate =
       camera.intrinsics().fps > 0 ? std::min(1.0, camera.intrinsics().fps / 30.0) : 1.0;
   options.tracker.keyframes.fmin = rate < 0.5 ? 0 : static_cast<int>(std::lround(10 * rate));
