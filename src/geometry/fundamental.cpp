@@ -7,11 +7,10 @@
 
 #include "geometry/chi_square.h"
 #include "geometry/point_normalization.h"
+#include "geometry/two_view_ransac.h"
 
 namespace edgeslam {
 namespace {
-
-constexpr int kMaxRefitRounds = 5;
 
 std::optional<Eigen::Matrix3d> eightPointNormalized(std::span<const Eigen::Vector2d> n1,
                                                     std::span<const Eigen::Vector2d> n2,
@@ -112,35 +111,19 @@ FundamentalEstimate findFundamentalRansac(std::span<const Eigen::Vector2d> point
   } catch (const std::invalid_argument&) {
     return best;
   }
-  for (int s = 0; s < sample_sets.count; ++s) {
-    const auto Fn =
-        eightPointNormalized(n1.points, n2.points, std::span<const int>(sample_sets.set(s), 8));
-    if (!Fn) continue;
-    const Eigen::Matrix3d F = denormalize(*Fn, n1.T, n2.T);
-    TwoViewScore score = scoreFundamental(F, points1, points2, sigma_px);
-    if (!best.valid || score.score > best.score.score) {
-      best.valid = true;
-      best.F21 = F;
-      best.score = std::move(score);
-    }
-  }
-  if (!best.valid || best.score.num_inliers < 8) return best;
-
-  // Local optimisation: re-fit on the inliers while the score improves (the inlier set of one
-  // noisy minimal sample is refined into the least-squares model of the whole consensus).
-  for (int round = 0; round < kMaxRefitRounds; ++round) {
-    std::vector<int> inliers;
-    for (size_t i = 0; i < points1.size(); ++i) {
-      if (best.score.inliers[i]) inliers.push_back(static_cast<int>(i));
-    }
-    const auto Fn = eightPointNormalized(n1.points, n2.points, inliers);
-    if (!Fn) break;
-    const Eigen::Matrix3d F = denormalize(*Fn, n1.T, n2.T);
-    TwoViewScore score = scoreFundamental(F, points1, points2, sigma_px);
-    if (!(score.score > best.score.score)) break;
-    best.F21 = F;
-    best.score = std::move(score);
-  }
+  const TwoViewModelEstimate found = ransacWithRefit(
+      points1.size(), sample_sets, 8,
+      [&](std::span<const int> indices) -> std::optional<Eigen::Matrix3d> {
+        const auto normalized = eightPointNormalized(n1.points, n2.points, indices);
+        if (!normalized) return std::nullopt;
+        return denormalize(*normalized, n1.T, n2.T);
+      },
+      [&](const Eigen::Matrix3d& model) {
+        return scoreFundamental(model, points1, points2, sigma_px);
+      });
+  best.valid = found.valid;
+  if (found.valid) best.F21 = found.model;
+  best.score = found.score;
   return best;
 }
 

@@ -7,11 +7,10 @@
 
 #include "geometry/chi_square.h"
 #include "geometry/point_normalization.h"
+#include "geometry/two_view_ransac.h"
 
 namespace edgeslam {
 namespace {
-
-constexpr int kMaxRefitRounds = 5;
 
 // Relative determinant below which a homography is treated as singular (collapses the plane).
 constexpr double kMinRelativeDeterminant = 1e-9;
@@ -117,35 +116,19 @@ HomographyEstimate findHomographyRansac(std::span<const Eigen::Vector2d> points1
   } catch (const std::invalid_argument&) {
     return best;
   }
-  for (int s = 0; s < sample_sets.count; ++s) {
-    const auto Hn =
-        dltNormalized(n1.points, n2.points, std::span<const int>(sample_sets.set(s), 4));
-    if (!Hn) continue;
-    const Eigen::Matrix3d H = denormalize(*Hn, n1.T, n2.T);
-    TwoViewScore score = scoreHomography(H, points1, points2, sigma_px);
-    if (!best.valid || score.score > best.score.score) {
-      best.valid = true;
-      best.H21 = H;
-      best.score = std::move(score);
-    }
-  }
-  if (!best.valid || best.score.num_inliers < 4) return best;
-
-  // Local optimisation: re-fit on the inliers while the score improves (the inlier set of one
-  // noisy minimal sample is refined into the least-squares model of the whole consensus).
-  for (int round = 0; round < kMaxRefitRounds; ++round) {
-    std::vector<int> inliers;
-    for (size_t i = 0; i < points1.size(); ++i) {
-      if (best.score.inliers[i]) inliers.push_back(static_cast<int>(i));
-    }
-    const auto Hn = dltNormalized(n1.points, n2.points, inliers);
-    if (!Hn) break;
-    const Eigen::Matrix3d H = denormalize(*Hn, n1.T, n2.T);
-    TwoViewScore score = scoreHomography(H, points1, points2, sigma_px);
-    if (!(score.score > best.score.score)) break;
-    best.H21 = H;
-    best.score = std::move(score);
-  }
+  const TwoViewModelEstimate found = ransacWithRefit(
+      points1.size(), sample_sets, 4,
+      [&](std::span<const int> indices) -> std::optional<Eigen::Matrix3d> {
+        const auto normalized = dltNormalized(n1.points, n2.points, indices);
+        if (!normalized) return std::nullopt;
+        return denormalize(*normalized, n1.T, n2.T);
+      },
+      [&](const Eigen::Matrix3d& model) {
+        return scoreHomography(model, points1, points2, sigma_px);
+      });
+  best.valid = found.valid;
+  if (found.valid) best.H21 = found.model;
+  best.score = found.score;
   return best;
 }
 

@@ -8,28 +8,17 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "support/edgeslam_command.h"
 #include "support/shared_data.h"
 
 namespace edgeslam {
 namespace {
 
-struct CommandResult {
-  int exit_code = -1;
-  std::string out;  // stdout only; stderr is discarded unless merged into the command
-};
+using test::CommandResult;
 
+// stdout only, so that --json output parses on its own; calls that want stderr add 2>&1.
 CommandResult runEdgeslam(const std::string& arguments) {
-  const std::string command = test::edgeslamBinary().string() + " " + arguments;
-  CommandResult result;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return result;
-  std::array<char, 4096> buffer{};
-  while (const std::size_t n = fread(buffer.data(), 1, buffer.size(), pipe)) {
-    result.out.append(buffer.data(), n);
-  }
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
+  return test::runEdgeslam(arguments, /*merge_stderr=*/false);
 }
 
 std::string evo(const std::string& name) {
@@ -43,8 +32,8 @@ TEST(EvalCli, AteJsonOnFr2Desk) {
   const CommandResult r =
       runEdgeslam("eval ate --gt " + evo("fr2_desk_groundtruth.txt") + " --est " +
                   evo("fr2_desk_ORB.txt") + " --json --plot " + plot.string());
-  ASSERT_EQ(r.exit_code, 0) << r.out;
-  const auto j = nlohmann::json::parse(r.out);  // exactly one object, nothing else
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = nlohmann::json::parse(r.output);  // exactly one object, nothing else
   EXPECT_EQ(j.at("metric"), "ate");
   EXPECT_EQ(j.at("align"), "se3");
   EXPECT_EQ(j.at("pairs"), 2223);
@@ -61,8 +50,8 @@ TEST(EvalCli, KittiAndRpeJson) {
   const std::string files =
       " --gt " + evo("KITTI_00_gt.txt") + " --est " + evo("KITTI_00_ORB.txt") + " --json";
   const CommandResult kitti = runEdgeslam("eval kitti" + files);
-  ASSERT_EQ(kitti.exit_code, 0) << kitti.out;
-  const auto k = nlohmann::json::parse(kitti.out);
+  ASSERT_EQ(kitti.exit_code, 0) << kitti.output;
+  const auto k = nlohmann::json::parse(kitti.output);
   EXPECT_NEAR(k.at("t_rel_percent").get<double>(), 0.699729, 1e-4);
   EXPECT_NEAR(k.at("r_rel_deg_per_100m").get<double>(), 0.253330, 1e-4);
   EXPECT_EQ(k.at("lengths").size(), 8U);
@@ -70,8 +59,8 @@ TEST(EvalCli, KittiAndRpeJson) {
 
   const CommandResult rpe =
       runEdgeslam("eval rpe" + files + " --delta 100 --delta-unit metres --format kitti");
-  ASSERT_EQ(rpe.exit_code, 0) << rpe.out;
-  const auto r = nlohmann::json::parse(rpe.out);
+  ASSERT_EQ(rpe.exit_code, 0) << rpe.output;
+  const auto r = nlohmann::json::parse(rpe.output);
   EXPECT_EQ(r.at("metric"), "rpe");
   EXPECT_EQ(r.at("delta_unit"), "metres");
   EXPECT_GT(r.at("pairs").get<int>(), 4000);
@@ -84,16 +73,16 @@ TEST(EvalCli, TextTableByDefault) {
   EDGESLAM_REQUIRE_SHARED("datasets/trajectories/evo/fr2_desk_ORB.txt");
   const CommandResult r = runEdgeslam("eval ate --gt " + evo("fr2_desk_groundtruth.txt") +
                                       " --est " + evo("fr2_desk_ORB.txt") + " --align sim3");
-  ASSERT_EQ(r.exit_code, 0) << r.out;
-  EXPECT_NE(r.out.find("sim3 alignment, 2223 pose pairs"), std::string::npos) << r.out;
-  EXPECT_NE(r.out.find("rmse"), std::string::npos) << r.out;
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("sim3 alignment, 2223 pose pairs"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("rmse"), std::string::npos) << r.output;
 }
 
 TEST(EvalCli, FailuresExitNonZeroWithMessage) {
   const CommandResult missing =
       runEdgeslam("eval ate --gt /nonexistent/gt.txt --est /nonexistent/est.txt 2>&1");
   EXPECT_NE(missing.exit_code, 0);
-  EXPECT_NE(missing.out.find("/nonexistent/gt.txt"), std::string::npos) << missing.out;
+  EXPECT_NE(missing.output.find("/nonexistent/gt.txt"), std::string::npos) << missing.output;
 
   const auto dir = std::filesystem::temp_directory_path();
   const auto gt = dir / "edgeslam_eval_cli_gt.txt";
@@ -103,13 +92,13 @@ TEST(EvalCli, FailuresExitNonZeroWithMessage) {
   const CommandResult apart =
       runEdgeslam("eval ate --gt " + gt.string() + " --est " + est.string() + " 2>&1");
   EXPECT_NE(apart.exit_code, 0);
-  EXPECT_NE(apart.out.find("no poses associated"), std::string::npos) << apart.out;
+  EXPECT_NE(apart.output.find("no poses associated"), std::string::npos) << apart.output;
 
   std::ofstream(est) << "1.0 0 0 0 0 0 0 1\n2.0 1 0 0 0 0 0 1\n";
   const CommandResult few =
       runEdgeslam("eval ate --gt " + gt.string() + " --est " + est.string() + " 2>&1");
   EXPECT_NE(few.exit_code, 0);
-  EXPECT_NE(few.out.find("at least 3 pose pairs"), std::string::npos) << few.out;
+  EXPECT_NE(few.output.find("at least 3 pose pairs"), std::string::npos) << few.output;
   std::filesystem::remove(gt);
   std::filesystem::remove(est);
 }

@@ -6,27 +6,13 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "support/edgeslam_command.h"
 #include "support/shared_data.h"
 
 namespace edgeslam {
 namespace {
 
-struct CommandResult {
-  int exit_code = -1;
-  std::string output;
-};
-
-CommandResult runEdgeslam(const std::string& arguments) {
-  const std::string command = test::edgeslamBinary().string() + " " + arguments + " 2>&1";
-  CommandResult result;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return result;
-  std::array<char, 4096> buffer{};
-  while (fgets(buffer.data(), buffer.size(), pipe) != nullptr) result.output += buffer.data();
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
+using test::runEdgeslam;
 
 TEST(DatasetInfoCommand, JsonOnSevenScenes) {
   EDGESLAM_REQUIRE_SHARED("datasets/7scenes-redkitchen-1000");

@@ -9,27 +9,11 @@
 #include <string>
 
 #include "io/trajectory.h"
+#include "support/edgeslam_command.h"
 #include "support/shared_data.h"
 
 namespace edgeslam {
 namespace {
-
-struct CommandResult {
-  int exit_code = -1;
-  std::string output;
-};
-
-CommandResult runCommand(const std::string& arguments) {
-  const std::string command = test::edgeslamBinary().string() + " " + arguments + " 2>&1";
-  CommandResult result;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return result;
-  std::array<char, 4096> buffer{};
-  while (fgets(buffer.data(), buffer.size(), pipe) != nullptr) result.output += buffer.data();
-  const int status = pclose(pipe);
-  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return result;
-}
 
 std::filesystem::path freshDir(const std::string& name) {
   const auto dir = std::filesystem::temp_directory_path() / ("edgeslam_run_test_" + name);
@@ -40,9 +24,9 @@ std::filesystem::path freshDir(const std::string& name) {
 TEST(RunCommand, WritesTheContractOutputs) {
   EDGESLAM_REQUIRE_SHARED("datasets/7scenes-redkitchen-1000");
   const auto out = freshDir("outputs");
-  const auto r =
-      runCommand("run --dataset " + test::sharedPath("datasets/7scenes-redkitchen-1000").string() +
-                 " --sensor rgbd --mode local --max-frames 40 --out " + out.string());
+  const auto r = test::runEdgeslam(
+      "run --dataset " + test::sharedPath("datasets/7scenes-redkitchen-1000").string() +
+      " --sensor rgbd --mode local --max-frames 40 --out " + out.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("Summary"), std::string::npos);
   for (const char* file :
@@ -68,15 +52,16 @@ TEST(RunCommand, WritesTheContractOutputs) {
 }
 
 TEST(RunCommand, MissingDatasetIsAClearError) {
-  const auto r = runCommand("run --dataset /nonexistent/edgeslam-data --out /tmp/x");
+  const auto r = test::runEdgeslam("run --dataset /nonexistent/edgeslam-data --out /tmp/x");
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.output.find("/nonexistent/edgeslam-data"), std::string::npos) << r.output;
 }
 
 TEST(RunCommand, RgbdWithoutDepthIsRejected) {
   EDGESLAM_REQUIRE_SHARED("datasets/kitti07-160");
-  const auto r = runCommand("run --dataset " + test::sharedPath("datasets/kitti07-160").string() +
-                            " --sensor rgbd --max-frames 5");
+  const auto r =
+      test::runEdgeslam("run --dataset " + test::sharedPath("datasets/kitti07-160").string() +
+                        " --sensor rgbd --max-frames 5");
   EXPECT_NE(r.exit_code, 0);
   EXPECT_NE(r.output.find("depth"), std::string::npos) << r.output;
 }
