@@ -1,15 +1,29 @@
 #pragma once
-// Each sub-command registers itself on the root app; the callback runs the command and sets the
-// exit code.
+// Each sub-command file registers itself with a `CommandRegistration` at namespace scope; main()
+// adds every registered command to the root app in the order of their `rank`. The callback of a
+// command runs it and sets the exit code.
 #include <CLI/CLI.hpp>
+#include <functional>
+#include <vector>
 
 namespace edgeslam::cli {
 
 // Exit code of the sub-command that ran (0 when none ran yet).
 int& exitCode();
 
-void addRunCommand(CLI::App& app);
-void addEvalCommands(CLI::App& app);
-void addDatasetCommands(CLI::App& app);
+using AddCommand = std::function<void(CLI::App&)>;
+
+struct RegisteredCommand {
+  int rank = 0;  // position in `edgeslam --help`: lower first
+  AddCommand add;
+};
+
+std::vector<RegisteredCommand>& registeredCommands();
+
+struct CommandRegistration {
+  CommandRegistration(int rank, AddCommand add) {
+    registeredCommands().push_back({rank, std::move(add)});
+  }
+};
 
 }  // namespace edgeslam::cli

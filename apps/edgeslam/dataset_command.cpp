@@ -134,4 +134,6 @@ void addDatasetCommands(CLI::App& app) {
   });
 }
 
+const CommandRegistration kDatasetCommandsRegistration{50, addDatasetCommands};
+
 }  // namespace edgeslam::cli

@@ -211,4 +211,6 @@ void addEvalCommands(CLI::App& app) {
   kitti->callback(guarded("kitti", [kitti_options] { runKitti(*kitti_options); }));
 }
 
+const CommandRegistration kEvalCommandsRegistration{40, addEvalCommands};
+
 }  // namespace edgeslam::cli

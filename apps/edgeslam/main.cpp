@@ -2,6 +2,7 @@
 #include <spdlog/spdlog.h>
 
 #include <CLI/CLI.hpp>
+#include <algorithm>
 #include <exception>
 #include <string>
 
@@ -12,6 +13,11 @@ namespace edgeslam::cli {
 int& exitCode() {
   static int code = 0;
   return code;
+}
+
+std::vector<RegisteredCommand>& registeredCommands() {
+  static std::vector<RegisteredCommand> commands;
+  return commands;
 }
 
 }  // namespace edgeslam::cli
@@ -28,9 +34,10 @@ int main(int argc, char** argv) {
   app.parse_complete_callback([&] { spdlog::set_level(spdlog::level::from_str(log_level)); });
   spdlog::set_pattern("[%H:%M:%S.%e] [%^%l%$] %v");
 
-  edgeslam::cli::addRunCommand(app);
-  edgeslam::cli::addEvalCommands(app);
-  edgeslam::cli::addDatasetCommands(app);
+  auto commands = edgeslam::cli::registeredCommands();
+  std::stable_sort(commands.begin(), commands.end(),
+                   [](const auto& a, const auto& b) { return a.rank < b.rank; });
+  for (const auto& command : commands) command.add(app);
 
   try {
     app.parse(argc, argv);

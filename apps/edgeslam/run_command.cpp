@@ -240,4 +240,6 @@ void addRunCommand(CLI::App& app) {
   run->callback([options] { exitCode() = runPipeline(*options); });
 }
 
+const CommandRegistration kRunCommandRegistration{10, addRunCommand};
+
 }  // namespace edgeslam::cli

@@ -1,0 +1,100 @@
+#pragma once
+// Plain-data images of map elements, as they cross the wire between client and edge: no pointers,
+// only ids. A keyframe upload goes client -> edge; a map slice goes edge -> client.
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "geometry/se3.h"
+#include "map/ids.h"
+
+namespace edgeslam {
+
+using Descriptor = std::array<std::uint8_t, 32>;
+
+struct PointObservationRecord {
+  KeyFrameId keyframe = kInvalidId;
+  std::uint32_t keypoint_index = 0;
+};
+
+struct MapPointRecord {
+  MapPointId id = kInvalidId;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  Descriptor descriptor{};
+  float min_distance = 0.f;  // raw scale-invariance range (MapPoint applies its 0.8 / 1.2 margins)
+  float max_distance = 0.f;
+  KeyFrameId reference_keyframe = kInvalidId;
+  std::vector<PointObservationRecord> observations;
+};
+
+// A keyframe's features as extracted on the client: enough to rebuild its FrameFeatures on the
+// other side (the grid is rebuilt from the session's camera).
+struct KeyFrameFeaturesRecord {
+  std::vector<cv::KeyPoint> keypoints;  // undistorted, octave = pyramid level
+  cv::Mat descriptors;                  // N x 32 CV_8U
+  std::vector<float> depth;             // empty, or one per keypoint (<= 0 unknown)
+  std::vector<float> right_u;           // empty, or one per keypoint
+  int pyramid_levels = 8;
+  double scale_factor = 1.2;
+  float bf = 0.f;
+};
+
+struct KeyFrameRecord {
+  KeyFrameId id = kInvalidId;
+  std::uint64_t frame_index = 0;
+  double timestamp = 0.0;
+  SE3d T_cw;
+  KeyFrameId parent = kInvalidId;
+  KeyFrameFeaturesRecord features;
+  std::vector<MapPointId> point_ids;  // per keypoint, kInvalidId where none
+};
+
+// Client -> edge: a new keyframe, the points the client created with it (RGB-D/stereo depth or
+// local triangulation), and optionally the compressed image for segmentation.
+struct KeyFrameUpload {
+  std::uint64_t sequence = 0;  // per session, increasing
+  KeyFrameRecord keyframe;
+  std::vector<MapPointRecord> new_points;
+  std::string image_encoding;  // "" (none), "jpeg", "png"
+  std::vector<std::uint8_t> image_bytes;
+  std::uint64_t acknowledged_slice = 0;  // last slice the client applied
+};
+
+struct KeyFramePoseRecord {
+  KeyFrameId id = kInvalidId;
+  SE3d T_cw;
+  KeyFrameId parent = kInvalidId;
+};
+
+// A movable-object mask of a keyframe, compact: label image at reduced resolution, encoded.
+struct MaskRecord {
+  KeyFrameId keyframe = kInvalidId;
+  int width = 0;  // of the encoded label image
+  int height = 0;
+  std::string encoding;  // "png" or "rle"
+  std::vector<std::uint8_t> bytes;
+};
+
+// Edge -> client: what changed in the global map since the last slice the client acknowledged.
+struct MapSlice {
+  std::uint64_t sequence = 0;         // per session, increasing
+  std::uint64_t upload_sequence = 0;  // the keyframe upload this slice answers (0 = none)
+  KeyFrameId processed_keyframe = kInvalidId;
+  bool full_resync = false;               // the client must drop its map and take this one
+  std::vector<KeyFrameRecord> keyframes;  // keyframes the client does not have (resync, edge-made)
+  std::vector<MapPointRecord> points_upserted;
+  std::vector<MapPointId> points_erased;
+  std::vector<KeyFramePoseRecord> keyframe_poses;
+  std::vector<KeyFrameId> keyframes_erased;
+  KeyFrameId reference_keyframe = kInvalidId;
+  std::optional<SE3d> reference_pose;  // T_cw of the reference keyframe after optimisation
+  std::vector<MaskRecord> masks;
+  std::uint32_t loops_closed = 0;  // loops closed on the edge since the last slice
+};
+
+}  // namespace edgeslam
