@@ -13,6 +13,8 @@
 #include "io/camera_file.h"
 #include "io/dataset.h"
 #include "io/trajectory.h"
+#include "pipeline/edge_slam.h"
+#include "pipeline/in_process_edge_link.h"
 #include "pipeline/local_slam.h"
 #include "progress_line.h"
 #include "run_options.h"
@@ -59,6 +61,15 @@ Sensor toSensor(const std::string& name) {
   return Sensor::kMonocular;
 }
 
+std::unique_ptr<SlamSystem> makeSlamSystem(const std::string& mode, const PinholeCamera& camera,
+                                           const SlamOptions& options) {
+  if (mode == "local") return std::make_unique<LocalSlam>(camera, options);
+  EdgeMapSessionOptions edge_options;
+  edge_options.mapper = options.mapper;
+  auto link = std::make_unique<InProcessEdgeLink>(camera, options.sensor, edge_options);
+  return std::make_unique<EdgeSlam>(camera, options, std::move(link));
+}
+
 int runPipeline(const RunOptions& options) {
   DatasetOptions dataset_options;
   dataset_options.format = parseDatasetFormat(options.format);
@@ -75,13 +86,12 @@ int runPipeline(const RunOptions& options) {
   spdlog::info("dataset {} ({}, {} frames, {} fps), camera {}", info.path.string(),
                toString(info.format), info.frame_count, info.fps, reader->camera().describe());
   std::string mode = options.mode;
-  if (mode != "local") {
-    spdlog::warn("--mode {} is not built yet: running the same SLAM in one process (local mode)",
-                 mode);
-    mode = "local";
+  if (mode == "offload") {
+    spdlog::warn("--mode offload is not built yet: running edge mode");
+    mode = "edge";
   }
 
-  LocalSlamOptions slam_options = defaultLocalSlamOptions(reader->camera(), sensor);
+  SlamOptions slam_options = defaultSlamOptions(reader->camera(), sensor);
   if (options.features) slam_options.orb.num_features = *options.features;
   if (options.levels) slam_options.orb.num_levels = *options.levels;
   KeyFrameParameters& kf = slam_options.tracker.keyframes;
@@ -94,7 +104,9 @@ int runPipeline(const RunOptions& options) {
   spdlog::info("{} ORB features, {} levels; keyframes fmin {} fmax {} alpha {} beta {}",
                slam_options.orb.num_features, slam_options.orb.num_levels, kf.fmin, kf.fmax,
                kf.alpha, kf.beta);
-  LocalSlam slam(reader->camera(), slam_options);
+  const std::unique_ptr<SlamSystem> slam_system =
+      makeSlamSystem(mode, reader->camera(), slam_options);
+  SlamSystem& slam = *slam_system;
   SampleStats client_ms, load_ms;
   ProgressLine progress;
   Stopwatch wall;
@@ -138,6 +150,8 @@ int runPipeline(const RunOptions& options) {
   const auto ate_final = ateJson(ground_truth, final_traj, align);
 
   const PercentileSummary zero;
+  const SlamCounters counters = slam.counters();
+  const std::size_t keyframes_uploaded = std::max<std::size_t>(1, counters.keyframes_uploaded);
   nlohmann::json metrics = {{"frames", frame_count},
                             {"tracked", tracked},
                             {"lost", lost},
@@ -145,12 +159,17 @@ int runPipeline(const RunOptions& options) {
                             {"map_points", slam.mapPointCount()},
                             {"client_ms", toJson(client)},
                             {"e2e_ms", toJson(client)},
-                            {"uplink_bytes", 0},
-                            {"downlink_bytes", 0},
-                            {"bytes_per_keyframe", 0},
-                            {"slice_latency_ms", toJson(zero)},
+                            {"uplink_bytes", counters.uplink_bytes},
+                            {"downlink_bytes", counters.downlink_bytes},
+                            {"bytes_per_keyframe", counters.uplink_bytes / keyframes_uploaded},
+                            {"keyframes_uploaded", counters.keyframes_uploaded},
+                            {"uploads_dropped", counters.uploads_dropped},
+                            {"slices_applied", counters.slices_applied},
+                            {"reconnects", counters.reconnects},
+                            {"slice_latency_ms", toJson(counters.slice_latency_ms)},
+                            {"slice_apply_ms", toJson(counters.slice_apply_ms)},
                             {"segmentation_ms", toJson(zero)},
-                            {"loops", 0},
+                            {"loops", counters.loops},
                             {"relocalizations", slam.tracker().relocalizations()},
                             {"map_resets", slam.tracker().resets()},
                             {"mode", mode},
@@ -170,6 +189,13 @@ int runPipeline(const RunOptions& options) {
   fmt::print("  map          {} keyframes, {} points, {} relocalisations, {} resets\n",
              slam.keyFrameCount(), slam.mapPointCount(), slam.tracker().relocalizations(),
              slam.tracker().resets());
+  if (mode != "local") {
+    fmt::print(
+        "  edge         {} keyframes up, {} slices back, slice latency median {:.1f} ms p90 "
+        "{:.1f} ms, {} B up, {} B down\n",
+        counters.keyframes_uploaded, counters.slices_applied, counters.slice_latency_ms.median,
+        counters.slice_latency_ms.p90, counters.uplink_bytes, counters.downlink_bytes);
+  }
   fmt::print("  client ms    median {:.2f}  p90 {:.2f}  p99 {:.2f}  max {:.2f}\n", client.median,
              client.p90, client.p99, client.max);
   if (ate) {

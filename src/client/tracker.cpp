@@ -143,22 +143,26 @@ bool Tracker::initialize(Frame& frame) {
     spdlog::debug("frame {}: not initialised: {}", frame.index, mono_init_.lastFailure());
     return false;
   }
-  std::lock_guard lock(map_.updateMutex());
-  KeyFrame* kf0 = map_.originKeyFrame();
-  spdlog::info("monocular map initialised at frame {} with {} points (reference frame {})",
-               frame.index, map_.pointCount(), kf0->frameIndex());
-  reference_keyframe_ = kf;
-  last_keyframe_frame_ = frame.index;
-  frame.reference_keyframe = kf;
-  // The reference frame's own record gets its pose now that the map exists.
-  for (FrameRecord& r : records_) {
-    if (r.index == kf0->frameIndex()) {
-      r.tracked = true;
-      r.reference = kf0;
-      r.T_cr = SE3d();
-      r.T_cw = SE3d();
+  KeyFrame* kf0 = nullptr;
+  {
+    std::lock_guard lock(map_.updateMutex());
+    kf0 = map_.originKeyFrame();
+    spdlog::info("monocular map initialised at frame {} with {} points (reference frame {})",
+                 frame.index, map_.pointCount(), kf0->frameIndex());
+    reference_keyframe_ = kf;
+    last_keyframe_frame_ = frame.index;
+    frame.reference_keyframe = kf;
+    // The reference frame's own record gets its pose now that the map exists.
+    for (FrameRecord& r : records_) {
+      if (r.index == kf0->frameIndex()) {
+        r.tracked = true;
+        r.reference = kf0;
+        r.T_cr = SE3d();
+        r.T_cw = SE3d();
+      }
     }
   }
+  // The sink takes the map's mutex itself.
   if (sink_ != nullptr) {
     sink_->insertKeyFrame(kf0);
     sink_->insertKeyFrame(kf);

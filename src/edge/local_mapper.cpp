@@ -107,6 +107,15 @@ void LocalMapper::run() {
 }
 
 void LocalMapper::processKeyFrame(KeyFrame* keyframe) {
+  mapKeyFrame(keyframe);
+  {
+    std::lock_guard lock(stats_mutex_);
+    ++stats_.keyframes_processed;
+  }
+  if (on_mapped_) on_mapped_(keyframe);
+}
+
+void LocalMapper::mapKeyFrame(KeyFrame* keyframe) {
   if (reset_requested_.exchange(false)) recent_points_.clear();
   {
     std::lock_guard lock(map_.updateMutex());
@@ -130,8 +139,6 @@ void LocalMapper::processKeyFrame(KeyFrame* keyframe) {
     if (options_.cull_keyframes) cullKeyFrames(keyframe);
   }
   last_optimized_frame_ = keyframe->frameIndex();
-  std::lock_guard lock(stats_mutex_);
-  ++stats_.keyframes_processed;
 }
 
 void LocalMapper::linkKeyFrame(KeyFrame* keyframe) {

@@ -7,6 +7,7 @@
 #include <condition_variable>
 #include <cstddef>
 #include <deque>
+#include <functional>
 #include <list>
 #include <mutex>
 #include <thread>
@@ -58,9 +59,15 @@ class LocalMapper : public KeyFrameSink {
 
   LocalMapperStats stats() const;
 
+  // Called on the mapping thread after each keyframe is mapped (set before start()).
+  void setKeyFrameMappedCallback(std::function<void(KeyFrame*)> callback) {
+    on_mapped_ = std::move(callback);
+  }
+
  private:
   void run();
   void processKeyFrame(KeyFrame* keyframe);
+  void mapKeyFrame(KeyFrame* keyframe);
   void linkKeyFrame(KeyFrame* keyframe);
   void cullRecentPoints(KeyFrame* keyframe);
   void createNewPoints(KeyFrame* keyframe);
@@ -86,6 +93,7 @@ class LocalMapper : public KeyFrameSink {
   std::list<MapPoint*> recent_points_;
   mutable std::mutex stats_mutex_;
   LocalMapperStats stats_;
+  std::function<void(KeyFrame*)> on_mapped_;
 };
 
 }  // namespace edgeslam

@@ -21,7 +21,7 @@ KeyFrame* Map::createKeyFrame(std::size_t frame_index, double timestamp,
     throw std::logic_error("Map: duplicate keyframe id");
   }
   if (origin_ == nullptr) origin_ = raw;
-  changes_.keyFrameCreated(id);
+  record().keyFrameCreated(id);
   return raw;
 }
 
@@ -36,7 +36,7 @@ MapPoint* Map::createMapPoint(const Eigen::Vector3d& position, KeyFrame* referen
   if (!points_.emplace(id, std::move(point)).second) {
     throw std::logic_error("Map: duplicate map point id");
   }
-  changes_.pointCreated(id);
+  record().pointCreated(id);
   return raw;
 }
 
@@ -54,7 +54,7 @@ void Map::addObservation(MapPoint* point, KeyFrame* keyframe, std::size_t index)
     point->observation_weight_ += keyframe->features().hasDepth(index) ? 2 : 1;
   }
   keyframe->points_[index] = point;
-  changes_.pointUpdated(point->id());
+  record().pointUpdated(point->id());
 }
 
 void Map::eraseObservation(MapPoint* point, KeyFrame* keyframe) {
@@ -70,7 +70,7 @@ void Map::eraseObservation(MapPoint* point, KeyFrame* keyframe) {
   if (point->observation_weight_ <= 2) {
     erasePoint(point);
   } else {
-    changes_.pointUpdated(point->id());
+    record().pointUpdated(point->id());
   }
 }
 
@@ -82,7 +82,7 @@ void Map::erasePoint(MapPoint* point) {
   }
   point->observations_.clear();
   point->observation_weight_ = 0;
-  changes_.pointErased(point->id());
+  record().pointErased(point->id());
   auto node = points_.extract(point->id());
   if (!node.empty()) retired_points_.push_back(std::move(node.mapped()));
 }
@@ -107,24 +107,33 @@ void Map::replacePoint(MapPoint* old_point, MapPoint* replacement) {
 
 void Map::setPointPosition(MapPoint* point, const Eigen::Vector3d& position) {
   point->position_ = position;
-  changes_.pointUpdated(point->id());
+  record().pointUpdated(point->id());
 }
 
 void Map::refreshPoint(MapPoint* point) {
   if (point->isBad()) return;
   point->computeDistinctiveDescriptor();
   point->updateNormalAndDepth();
-  changes_.pointUpdated(point->id());
+  record().pointUpdated(point->id());
+}
+
+void Map::setPointAppearance(MapPoint* point, const Eigen::Vector3d& normal,
+                             const cv::Mat& descriptor, float min_distance, float max_distance) {
+  point->normal_ = normal;
+  point->descriptor_ = descriptor.clone();
+  point->min_distance_ = min_distance;
+  point->max_distance_ = max_distance;
+  record().pointUpdated(point->id());
 }
 
 void Map::setKeyFramePose(KeyFrame* keyframe, const SE3d& T_cw) {
   keyframe->setPose(T_cw);
-  changes_.keyFrameUpdated(keyframe->id());
+  record().keyFrameUpdated(keyframe->id());
 }
 
 void Map::updateConnections(KeyFrame* keyframe) {
   keyframe->updateConnections();
-  changes_.keyFrameUpdated(keyframe->id());
+  record().keyFrameUpdated(keyframe->id());
 }
 
 void Map::eraseKeyFrame(KeyFrame* keyframe) {
@@ -167,7 +176,7 @@ void Map::eraseKeyFrame(KeyFrame* keyframe) {
     best_parent->children_.insert(best_child);
     candidates.insert(best_child);
     orphans.erase(best_child);
-    changes_.keyFrameUpdated(best_child->id());
+    record().keyFrameUpdated(best_child->id());
   }
   for (KeyFrame* orphan : orphans) {  // no covisible link left: hang them on the old parent
     orphan->parent_ = keyframe->parent_;
@@ -179,7 +188,7 @@ void Map::eraseKeyFrame(KeyFrame* keyframe) {
   }
   keyframe->children_.clear();
   keyframe->bad_ = true;
-  changes_.keyFrameErased(keyframe->id());
+  record().keyFrameErased(keyframe->id());
   auto node = keyframes_.extract(keyframe->id());
   if (!node.empty()) retired_keyframes_.push_back(std::move(node.mapped()));
 }
@@ -189,8 +198,8 @@ void Map::addLoopEdge(KeyFrame* a, KeyFrame* b) {
   b->loop_edges_.insert(a);
   a->protected_from_culling_ = true;
   b->protected_from_culling_ = true;
-  changes_.keyFrameUpdated(a->id());
-  changes_.keyFrameUpdated(b->id());
+  record().keyFrameUpdated(a->id());
+  record().keyFrameUpdated(b->id());
 }
 
 void Map::clear() {
@@ -232,6 +241,12 @@ KeyFrame* Map::keyFrame(KeyFrameId id) const {
 MapPoint* Map::mapPoint(MapPointId id) const {
   const auto it = points_.find(id);
   return it == points_.end() ? nullptr : it->second.get();
+}
+
+MapChanges& Map::record() {
+  if (recording_) return changes_;
+  ignored_changes_.clear();
+  return ignored_changes_;
 }
 
 MapChanges Map::takeChanges() {

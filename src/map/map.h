@@ -40,6 +40,9 @@ class Map {
   // Moves every observation of `old_point` to `replacement` (point fusion) and erases `old_point`.
   void replacePoint(MapPoint* old_point, MapPoint* replacement);
   void setPointPosition(MapPoint* point, const Eigen::Vector3d& position);
+  // Sets what refreshPoint would compute, as received from the other side of the wire.
+  void setPointAppearance(MapPoint* point, const Eigen::Vector3d& normal, const cv::Mat& descriptor,
+                          float min_distance, float max_distance);
   // Recomputes normal, distance range and representative descriptor from the observations.
   void refreshPoint(MapPoint* point);
 
@@ -63,6 +66,8 @@ class Map {
 
   const MapChanges& changes() const { return changes_; }
   MapChanges takeChanges();
+  // While off, changes are applied but not recorded (a replica applying what the other side sent).
+  void setChangeRecording(bool on) { recording_ = on; }
 
   IdAllocator& ids() { return ids_; }
 
@@ -75,6 +80,10 @@ class Map {
   std::vector<std::unique_ptr<MapPoint>> retired_points_;
   KeyFrame* origin_ = nullptr;
   MapChanges changes_;
+  MapChanges ignored_changes_;
+  bool recording_ = true;
+
+  MapChanges& record();
 };
 
 }  // namespace edgeslam

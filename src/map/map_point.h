@@ -36,6 +36,9 @@ class MapPoint {
   // Scale invariance: the distance range over which the point's descriptor is expected to match.
   float minDistance() const { return 0.8f * min_distance_; }
   float maxDistance() const { return 1.2f * max_distance_; }
+  // The range as computed from the reference observation, without the margins (for replicas).
+  float baseMinDistance() const { return min_distance_; }
+  float baseMaxDistance() const { return max_distance_; }
   // Pyramid level where the point should be seen at `distance` (clamped to [0, levels-1]).
   int predictLevel(float distance, float scale_factor, int levels) const;
 

@@ -58,6 +58,7 @@ struct KeyFrameRecord {
 // local triangulation), and optionally the compressed image for segmentation.
 struct KeyFrameUpload {
   std::uint64_t sequence = 0;  // per session, increasing
+  bool map_reset = false;      // the client emptied its map before this keyframe (failed start)
   KeyFrameRecord keyframe;
   std::vector<MapPointRecord> new_points;
   std::string image_encoding;  // "" (none), "jpeg", "png"
@@ -85,6 +86,9 @@ struct MapSlice {
   std::uint64_t sequence = 0;         // per session, increasing
   std::uint64_t upload_sequence = 0;  // the keyframe upload this slice answers (0 = none)
   KeyFrameId processed_keyframe = kInvalidId;
+  // The newest keyframe the edge had received when it built the slice: the observations a record
+  // lacks in keyframes up to this one were dropped on the edge; newer ones it has not seen yet.
+  KeyFrameId newest_keyframe = kInvalidId;
   bool full_resync = false;               // the client must drop its map and take this one
   std::vector<KeyFrameRecord> keyframes;  // keyframes the client does not have (resync, edge-made)
   std::vector<MapPointRecord> points_upserted;

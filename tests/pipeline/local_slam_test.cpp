@@ -20,7 +20,7 @@ struct RunOutcome {
 
 RunOutcome runSequence(const std::string& dataset, Sensor sensor, std::size_t frames) {
   auto reader = openDataset(test::sharedPath(dataset));
-  LocalSlam slam(reader->camera(), defaultLocalSlamOptions(reader->camera(), sensor));
+  LocalSlam slam(reader->camera(), defaultSlamOptions(reader->camera(), sensor));
   Trajectory ground_truth;
   RunOutcome out;
   out.frames = std::min(frames, reader->info().frame_count);

@@ -1,0 +1,54 @@
+#pragma once
+// The client's keyframe sink in edge mode: turns each new keyframe (and the points the client made
+// with it) into an upload, and learns from the slices which keyframes the edge has mapped.
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <mutex>
+#include <unordered_set>
+
+#include "client/keyframe_uplink.h"
+#include "map/keyframe_sink.h"
+#include "map/map.h"
+
+namespace edgeslam {
+
+struct EdgeKeyFrameSinkOptions {
+  // Tracking holds back optional keyframes while this many uploads wait for their slice.
+  std::size_t max_in_flight = 3;
+};
+
+class EdgeKeyFrameSink : public KeyFrameSink {
+ public:
+  EdgeKeyFrameSink(Map& map, KeyFrameUplink& uplink, EdgeKeyFrameSinkOptions options = {});
+
+  void insertKeyFrame(KeyFrame* keyframe) override;
+  bool acceptsKeyFrames() const override;
+  std::size_t lastOptimizedFrame() const override { return last_optimized_frame_.load(); }
+  void onMapReset() override;
+
+  // A slice answering upload `upload_sequence` was applied; returns the seconds since that upload
+  // was sent (negative when unknown), for the slice-latency statistics.
+  double onSliceApplied(std::uint64_t upload_sequence, std::size_t processed_frame_index);
+
+  std::uint64_t uploadsSent() const { return sequence_.load(); }
+  std::uint64_t uploadsAnswered() const { return answered_.load(); }
+  bool allAnswered() const { return answered_.load() >= sequence_.load(); }
+
+ private:
+  using Clock = std::chrono::steady_clock;
+
+  Map& map_;
+  KeyFrameUplink& uplink_;
+  EdgeKeyFrameSinkOptions options_;
+  std::atomic<std::uint64_t> sequence_{0};
+  std::atomic<std::uint64_t> answered_{0};
+  std::atomic<std::size_t> last_optimized_frame_{0};
+  bool reset_pending_ = false;
+  std::unordered_set<MapPointId> uploaded_points_;
+  std::mutex sent_mutex_;
+  std::deque<std::pair<std::uint64_t, Clock::time_point>> sent_times_;
+};
+
+}  // namespace edgeslam

@@ -1,0 +1,14 @@
+#pragma once
+// Where the client's keyframe uploads go: the gRPC client, or a direct call in tests. `send` must
+// not block tracking for long (queue and return).
+#include "map/map_records.h"
+
+namespace edgeslam {
+
+class KeyFrameUplink {
+ public:
+  virtual ~KeyFrameUplink() = default;
+  virtual void send(KeyFrameUpload upload) = 0;
+};
+
+}  // namespace edgeslam

@@ -1,0 +1,148 @@
+#include "map/map_replication.h"
+
+#include <cstring>
+#include <stdexcept>
+
+namespace edgeslam {
+
+KeyFrameFeaturesRecord featuresRecord(const FrameFeatures& features) {
+  KeyFrameFeaturesRecord record;
+  record.keypoints = features.keypoints;
+  record.descriptors = features.descriptors.clone();
+  record.depth = features.depth;
+  record.right_u = features.right_u;
+  record.pyramid_levels = features.scales.numLevels();
+  record.scale_factor = features.scales.scaleFactor();
+  record.bf = features.bf;
+  return record;
+}
+
+std::shared_ptr<FrameFeatures> featuresFromRecord(const KeyFrameFeaturesRecord& record,
+                                                  const PinholeCamera& camera) {
+  const std::size_t n = record.keypoints.size();
+  if (static_cast<std::size_t>(record.descriptors.rows) != n ||
+      (n > 0 && (record.descriptors.cols != 32 || record.descriptors.type() != CV_8U))) {
+    throw std::invalid_argument(
+        "keyframe features: descriptors must be one 32-byte row per keypoint");
+  }
+  if ((!record.depth.empty() && record.depth.size() != n) ||
+      (!record.right_u.empty() && record.right_u.size() != n)) {
+    throw std::invalid_argument(
+        "keyframe features: depth / right_u must have one value per keypoint");
+  }
+  auto features = std::make_shared<FrameFeatures>();
+  features->keypoints = record.keypoints;
+  features->descriptors = record.descriptors.clone();
+  features->depth = record.depth;
+  features->right_u = record.right_u;
+  features->scales = ScaleLevels(record.pyramid_levels, record.scale_factor);
+  for (const cv::KeyPoint& kp : features->keypoints) {
+    if (kp.octave < 0 || kp.octave >= record.pyramid_levels) {
+      throw std::invalid_argument("keyframe features: keypoint octave outside the pyramid");
+    }
+  }
+  features->bf = record.bf;
+  features->grid = FeatureGrid(camera.undistortedBounds(), features->keypoints);
+  return features;
+}
+
+KeyFrameRecord keyFrameRecord(const KeyFrame& keyframe) {
+  KeyFrameRecord record;
+  record.id = keyframe.id();
+  record.frame_index = keyframe.frameIndex();
+  record.timestamp = keyframe.timestamp();
+  record.T_cw = keyframe.pose();
+  record.parent = keyframe.parent() != nullptr ? keyframe.parent()->id() : kInvalidId;
+  record.features = featuresRecord(keyframe.features());
+  record.point_ids.assign(keyframe.size(), kInvalidId);
+  for (std::size_t i = 0; i < keyframe.size(); ++i) {
+    const MapPoint* p = keyframe.point(i);
+    if (p != nullptr && !p->isBad()) record.point_ids[i] = p->id();
+  }
+  return record;
+}
+
+MapPointRecord mapPointRecord(const MapPoint& point) {
+  MapPointRecord record;
+  record.id = point.id();
+  record.position = point.position();
+  record.normal = point.normal();
+  if (point.descriptor().total() == record.descriptor.size()) {
+    std::memcpy(record.descriptor.data(), point.descriptor().data, record.descriptor.size());
+  }
+  record.min_distance = point.baseMinDistance();
+  record.max_distance = point.baseMaxDistance();
+  record.reference_keyframe =
+      point.referenceKeyFrame() != nullptr ? point.referenceKeyFrame()->id() : kInvalidId;
+  record.observations.reserve(point.observations().size());
+  for (const auto& [id, obs] : point.observations()) {
+    record.observations.push_back({id, static_cast<std::uint32_t>(obs.index)});
+  }
+  return record;
+}
+
+KeyFramePoseRecord keyFramePoseRecord(const KeyFrame& keyframe) {
+  return {keyframe.id(), keyframe.pose(),
+          keyframe.parent() != nullptr ? keyframe.parent()->id() : kInvalidId};
+}
+
+KeyFrame* insertKeyFrameRecord(Map& map, const KeyFrameRecord& record,
+                               const PinholeCamera& camera) {
+  if (KeyFrame* existing = map.keyFrame(record.id)) return existing;
+  auto features = featuresFromRecord(record.features, camera);
+  if (!record.point_ids.empty() && record.point_ids.size() != features->size()) {
+    throw std::invalid_argument("keyframe record: point ids must be one per keypoint");
+  }
+  KeyFrame* keyframe = map.createKeyFrame(record.frame_index, record.timestamp, std::move(features),
+                                          record.T_cw, record.id);
+  for (std::size_t i = 0; i < record.point_ids.size(); ++i) {
+    if (record.point_ids[i] == kInvalidId) continue;
+    MapPoint* p = map.mapPoint(record.point_ids[i]);
+    if (p != nullptr && !p->isBad()) map.addObservation(p, keyframe, i);
+  }
+  return keyframe;
+}
+
+MapPoint* upsertPointRecord(Map& map, const MapPointRecord& record,
+                            KeyFrameId newest_known_to_sender) {
+  std::vector<std::pair<KeyFrame*, std::size_t>> observers;
+  for (const PointObservationRecord& obs : record.observations) {
+    KeyFrame* kf = map.keyFrame(obs.keyframe);
+    if (kf != nullptr && obs.keypoint_index < kf->size())
+      observers.emplace_back(kf, obs.keypoint_index);
+  }
+  MapPoint* point = map.mapPoint(record.id);
+  std::vector<KeyFrame*> dropped;
+  if (point == nullptr) {
+    if (observers.empty()) return nullptr;
+    KeyFrame* reference = map.keyFrame(record.reference_keyframe);
+    point = map.createMapPoint(record.position,
+                               reference != nullptr ? reference : observers[0].first, record.id);
+  } else {
+    map.setPointPosition(point, record.position);
+    // Observations the other side dropped (outliers, culled keyframes) go here too.
+    for (const auto& [id, obs] : point->observations()) {
+      const bool kept = std::any_of(observers.begin(), observers.end(),
+                                    [&](const auto& o) { return o.first == obs.keyframe; });
+      // Edge-made keyframes (origin 0) are always known to the edge; a client's are known up
+      // to the newest one the edge had received.
+      const bool sender_knew =
+          idOrigin(id) == 0 ||
+          (idOrigin(id) == idOrigin(newest_known_to_sender) && id <= newest_known_to_sender);
+      if (!kept && sender_knew) dropped.push_back(obs.keyframe);
+    }
+  }
+  // New observations first: dropping first could leave too few and erase the point.
+  for (const auto& [kf, index] : observers) map.addObservation(point, kf, index);
+  for (KeyFrame* kf : dropped) {
+    if (point->isBad()) break;
+    map.eraseObservation(point, kf);
+  }
+  if (point->isBad()) return nullptr;
+  const cv::Mat descriptor(1, 32, CV_8U, const_cast<std::uint8_t*>(record.descriptor.data()));
+  map.setPointAppearance(point, record.normal, descriptor, record.min_distance,
+                         record.max_distance);
+  return point;
+}
+
+}  // namespace edgeslam

@@ -1,0 +1,31 @@
+#pragma once
+// The client's connection to its edge session: keyframe uploads out, map slices in. Implemented
+// over gRPC (the real split) and in-process (tests, no network).
+#include <cstdint>
+#include <functional>
+
+#include "client/keyframe_uplink.h"
+#include "map/map_records.h"
+
+namespace edgeslam {
+
+struct EdgeLinkCounters {
+  std::uint64_t uplink_bytes = 0;
+  std::uint64_t downlink_bytes = 0;
+  std::uint64_t uploads_dropped = 0;
+  std::uint64_t reconnects = 0;
+};
+
+class EdgeLink : public KeyFrameUplink {
+ public:
+  using SliceHandler = std::function<void(MapSlice)>;
+
+  // The id origin byte the session gave this client (its map element ids start with it).
+  virtual std::uint8_t idOrigin() const = 0;
+  // Called on the link's own thread for every slice; set before the first upload.
+  virtual void setSliceHandler(SliceHandler handler) = 0;
+  virtual EdgeLinkCounters counters() const = 0;
+  virtual void close() = 0;
+};
+
+}  // namespace edgeslam

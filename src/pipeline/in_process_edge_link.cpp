@@ -1,0 +1,70 @@
+#include "pipeline/in_process_edge_link.h"
+
+#include <spdlog/spdlog.h>
+
+namespace edgeslam {
+
+InProcessEdgeLink::InProcessEdgeLink(const PinholeCamera& camera, Sensor sensor,
+                                     EdgeMapSessionOptions options) {
+  session_ = std::make_unique<EdgeMapSession>(camera, sensor, options, [this](MapSlice slice) {
+    if (handler_) handler_(std::move(slice));
+  });
+  worker_ = std::thread([this] { run(); });
+}
+
+InProcessEdgeLink::~InProcessEdgeLink() {
+  close();
+}
+
+void InProcessEdgeLink::send(KeyFrameUpload upload) {
+  {
+    std::lock_guard lock(mutex_);
+    queue_.push_back(std::move(upload));
+  }
+  cv_.notify_one();
+}
+
+void InProcessEdgeLink::run() {
+  while (true) {
+    KeyFrameUpload upload;
+    {
+      std::unique_lock lock(mutex_);
+      cv_.wait(lock, [this] { return closing_ || !queue_.empty(); });
+      if (queue_.empty()) return;
+      upload = std::move(queue_.front());
+      queue_.pop_front();
+      busy_ = true;
+    }
+    try {
+      session_->onKeyFrame(upload);
+    } catch (const std::exception& e) {
+      spdlog::error("edge session rejected keyframe upload {}: {}", upload.sequence, e.what());
+    }
+    {
+      std::lock_guard lock(mutex_);
+      busy_ = false;
+    }
+    drained_.notify_all();
+  }
+}
+
+void InProcessEdgeLink::flush() {
+  std::unique_lock lock(mutex_);
+  drained_.wait(lock, [this] { return queue_.empty() && !busy_; });
+  lock.unlock();
+  session_->finish();
+}
+
+void InProcessEdgeLink::close() {
+  {
+    std::lock_guard lock(mutex_);
+    if (closing_) return;
+    closing_ = true;
+  }
+  cv_.notify_all();
+  if (worker_.joinable()) worker_.join();
+  session_->finish();
+  session_->stop();
+}
+
+}  // namespace edgeslam

@@ -1,0 +1,83 @@
+#include "pipeline/slam_system.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace edgeslam {
+
+SlamOptions defaultSlamOptions(const PinholeCamera& camera, Sensor sensor) {
+  SlamOptions options;
+  options.sensor = sensor;
+  options.orb.num_features = camera.width() * camera.height() > 640 * 480 * 1.2 ? 2000 : 1000;
+  options.tracker.sensor = sensor;
+  // No network between tracking and mapping: N = 0, below paper Table I's first row (0, 10] ms,
+  // whose values we take. The table counts frames of a 30 fps camera, so the counts shrink with a
+  // slower camera; below 15 fps rule 1 is dropped altogether: consecutive frames are then already
+  // far apart (KITTI at 10 fps drives ~1 m per frame) and a minimum gap starves monocular tracking
+  // (KITTI 07: ATE 39 cm with fmin 3, 22-26 cm with fmin 0; 7-Scenes at 30 fps is best with fmin
+  // 10).
+  const double rate =
+      camera.intrinsics().fps > 0 ? std::min(1.0, camera.intrinsics().fps / 30.0) : 1.0;
+  options.tracker.keyframes.fmin = rate < 0.5 ? 0 : static_cast<int>(std::lround(10 * rate));
+  options.tracker.keyframes.fmax = std::max(1, static_cast<int>(std::lround(40 * rate)));
+  options.tracker.keyframes.alpha = 0.3;
+  options.tracker.keyframes.beta = 0.9;
+  options.mapper.monocular = sensor == Sensor::kMonocular;
+  return options;
+}
+
+SlamSystem::SlamSystem(const PinholeCamera& camera, SlamOptions options, std::uint8_t map_id_origin)
+    : camera_(camera), options_(std::move(options)), extractor_(options_.orb), map_(map_id_origin) {
+  options_.tracker.sensor = options_.sensor;
+  options_.mapper.monocular = options_.sensor == Sensor::kMonocular;
+}
+
+void SlamSystem::startTracking(KeyFrameSink* sink) {
+  tracker_ = std::make_unique<Tracker>(map_, camera_, options_.tracker, sink);
+}
+
+TrackResult SlamSystem::process(std::size_t frame_index, double timestamp, const cv::Mat& gray,
+                                const cv::Mat& depth) {
+  const cv::Mat& used_depth = options_.sensor == Sensor::kMonocular ? cv::Mat() : depth;
+  auto features = buildFrameFeatures(gray, used_depth, camera_, extractor_, options_.depth);
+  TrackResult result = tracker_->track(frame_index, timestamp, std::move(features));
+  afterFrame();
+  return result;
+}
+
+Trajectory SlamSystem::trajectoryAtFrameTime() const {
+  Trajectory out;
+  for (const auto& r : tracker_->records()) {
+    if (r.tracked) out.push_back({r.timestamp, r.T_cw.inverse()});
+  }
+  return out;
+}
+
+Trajectory SlamSystem::trajectoryFinal() const {
+  std::lock_guard lock(map_.updateMutex());
+  Trajectory out;
+  for (const auto& r : tracker_->records()) {
+    if (!r.tracked || r.reference == nullptr) continue;
+    out.push_back({r.timestamp, (r.T_cr * r.reference->latestPose()).inverse()});
+  }
+  return out;
+}
+
+Trajectory SlamSystem::keyframeTrajectory() const {
+  std::lock_guard lock(map_.updateMutex());
+  Trajectory out;
+  for (KeyFrame* kf : map_.keyFrames()) out.push_back({kf->timestamp(), kf->poseInverse()});
+  return out;
+}
+
+std::size_t SlamSystem::keyFrameCount() const {
+  std::lock_guard lock(map_.updateMutex());
+  return map_.keyFrameCount();
+}
+
+std::size_t SlamSystem::mapPointCount() const {
+  std::lock_guard lock(map_.updateMutex());
+  return map_.pointCount();
+}
+
+}  // namespace edgeslam

@@ -1,0 +1,82 @@
+#pragma once
+// What every run mode shares: feature extraction and tracking on the caller's thread against the
+// client's map, the trajectories and the counters. Modes differ in where keyframes go (local
+// mapping in-process, or the edge) and in what they count.
+#include <cstdint>
+#include <memory>
+#include <opencv2/core.hpp>
+
+#include "client/tracker.h"
+#include "edge/local_mapper.h"
+#include "features/frame_features_builder.h"
+#include "features/orb_extractor.h"
+#include "io/trajectory.h"
+#include "map/map.h"
+#include "util/timing_stats.h"
+
+namespace edgeslam {
+
+struct SlamOptions {
+  Sensor sensor = Sensor::kMonocular;
+  OrbExtractorOptions orb;
+  TrackerOptions tracker;
+  LocalMapperOptions mapper;
+  DepthOptions depth;
+  bool threaded_mapping = true;  // local mode, false: map each keyframe before the next frame
+};
+
+// Sensible defaults for a camera: 1000 features up to 640x480-ish, 2000 for wide images (KITTI).
+SlamOptions defaultSlamOptions(const PinholeCamera& camera, Sensor sensor);
+
+// Network and edge figures; zero in local mode.
+struct SlamCounters {
+  std::uint64_t uplink_bytes = 0;
+  std::uint64_t downlink_bytes = 0;
+  std::uint64_t keyframes_uploaded = 0;
+  std::uint64_t uploads_dropped = 0;
+  std::uint64_t slices_applied = 0;
+  std::uint64_t reconnects = 0;
+  std::uint64_t loops = 0;
+  PercentileSummary slice_latency_ms;
+  PercentileSummary slice_apply_ms;
+};
+
+class SlamSystem {
+ public:
+  virtual ~SlamSystem() = default;
+  SlamSystem(const SlamSystem&) = delete;
+  SlamSystem& operator=(const SlamSystem&) = delete;
+
+  // `depth` is CV_32FC1 metres (RGB-D) or empty.
+  TrackResult process(std::size_t frame_index, double timestamp, const cv::Mat& gray,
+                      const cv::Mat& depth);
+  // Lets mapping finish its backlog (call before reading the final trajectory).
+  virtual void finish() = 0;
+  virtual SlamCounters counters() const { return {}; }
+  virtual const char* modeName() const = 0;
+
+  // Pose of every tracked frame as it was estimated at that frame's time.
+  Trajectory trajectoryAtFrameTime() const;
+  // Every tracked frame relative to its reference keyframe's final pose.
+  Trajectory trajectoryFinal() const;
+  Trajectory keyframeTrajectory() const;
+
+  const Tracker& tracker() const { return *tracker_; }
+  // The client's map (lock its update mutex while reading it during a run).
+  const Map& map() const { return map_; }
+  std::size_t keyFrameCount() const;
+  std::size_t mapPointCount() const;
+
+ protected:
+  SlamSystem(const PinholeCamera& camera, SlamOptions options, std::uint8_t map_id_origin);
+  void startTracking(KeyFrameSink* sink);
+  virtual void afterFrame() {}
+
+  PinholeCamera camera_;
+  SlamOptions options_;
+  OrbExtractor extractor_;
+  Map map_;
+  std::unique_ptr<Tracker> tracker_;
+};
+
+}  // namespace edgeslam
