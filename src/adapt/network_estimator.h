@@ -1,0 +1,42 @@
+#pragma once
+// Latency L and bandwidth B of the link to the edge from probe results, and the network
+// condition N = L + M/B of paper Eq. (2).
+//  - L: round-trip time of small echo probes (a few tens of bytes each way);
+//  - B: a sized probe sends `bytes` and waits for a small reply, taking RTT + bytes/B, so
+//       B = bytes / (elapsed - L), with L the current latency estimate.
+// Both are the median of the last `window` samples: one outlier (a retransmission, a scheduler
+// hiccup) cannot move a median of 5, and a lasting change shows after 3 samples.
+#include <cstddef>
+#include <deque>
+#include <optional>
+
+namespace edgeslam {
+
+// N = L + M/B in ms; B in Mbit/s (0 or less: an unusable link, N = +inf).
+double networkTimeMs(double latency_ms, double bandwidth_mbps, double message_bytes);
+
+class NetworkEstimator {
+ public:
+  explicit NetworkEstimator(std::size_t window = 5);
+
+  // Throws std::invalid_argument for a negative or non-finite RTT.
+  void addLatencyProbe(double rtt_ms);
+  // `bytes` sent and acknowledged in `elapsed_ms`. Ignored (returns false) until a latency
+  // estimate exists or when elapsed_ms does not exceed it by a measurable amount.
+  bool addBandwidthProbe(std::size_t bytes, double elapsed_ms);
+
+  std::optional<double> latencyMs() const;
+  std::optional<double> bandwidthMbps() const;
+  // N for a message of `message_bytes`, once both estimates exist.
+  std::optional<double> networkTimeMs(double message_bytes) const;
+
+ private:
+  static void push(std::deque<double>& samples, double value, std::size_t window);
+  static double median(const std::deque<double>& samples);
+
+  std::size_t window_;
+  std::deque<double> latency_samples_;
+  std::deque<double> bandwidth_samples_;
+};
+
+}  // namespace edgeslam
