@@ -170,8 +170,8 @@ int runPipeline(const RunOptions& options) {
                             {"slice_apply_ms", toJson(counters.slice_apply_ms)},
                             {"segmentation_ms", toJson(zero)},
                             {"loops", counters.loops},
-                            {"relocalizations", slam.tracker().relocalizations()},
-                            {"map_resets", slam.tracker().resets()},
+                            {"relocalizations", slam.relocalizations()},
+                            {"map_resets", slam.mapResets()},
                             {"mode", mode},
                             {"requested_mode", options.mode},
                             {"sensor", sensor_name},
@@ -187,8 +187,7 @@ int runPipeline(const RunOptions& options) {
   fmt::print("  frames       {} in {:.2f} s ({:.1f} fps), tracked {}, lost {}\n", frame_count,
              seconds, static_cast<double>(frame_count) / std::max(seconds, 1e-9), tracked, lost);
   fmt::print("  map          {} keyframes, {} points, {} relocalisations, {} resets\n",
-             slam.keyFrameCount(), slam.mapPointCount(), slam.tracker().relocalizations(),
-             slam.tracker().resets());
+             slam.keyFrameCount(), slam.mapPointCount(), slam.relocalizations(), slam.mapResets());
   if (mode != "local") {
     fmt::print(
         "  edge         {} keyframes up, {} slices back, slice latency median {:.1f} ms p90 "

@@ -9,7 +9,7 @@
 namespace edgeslam {
 
 EdgeSlam::EdgeSlam(const PinholeCamera& camera, SlamOptions options, std::unique_ptr<EdgeLink> link)
-    : SlamSystem(camera, std::move(options), link->idOrigin()), link_(std::move(link)) {
+    : TrackingSlam(camera, std::move(options), link->idOrigin()), link_(std::move(link)) {
   sink_ = std::make_unique<EdgeKeyFrameSink>(map_, *link_);
   link_->setSliceHandler([this](MapSlice slice) { onSlice(std::move(slice)); });
   startTracking(sink_.get());
@@ -23,9 +23,10 @@ void EdgeSlam::onSlice(MapSlice slice) {
   Stopwatch apply_timer;
   const SliceApplyResult applied = applySlice(map_, slice, camera_);
   const double apply_ms = apply_timer.elapsedMs();
-  spdlog::debug("slice {} (keyframe of frame {}): {} points written, {} erased, {} poses, {:.1f} ms",
-                slice.sequence, applied.frame_index, applied.points_upserted,
-                applied.points_erased, applied.keyframes_moved, apply_ms);
+  spdlog::debug(
+      "slice {} (keyframe of frame {}): {} points written, {} erased, {} poses, {:.1f} ms",
+      slice.sequence, applied.frame_index, applied.points_upserted, applied.points_erased,
+      applied.keyframes_moved, apply_ms);
   const double latency_s = sink_->onSliceApplied(slice.upload_sequence, applied.frame_index);
   std::lock_guard lock(stats_mutex_);
   ++slices_applied_;

@@ -11,7 +11,7 @@
 
 namespace edgeslam {
 
-class EdgeSlam : public SlamSystem {
+class EdgeSlam : public TrackingSlam {
  public:
   EdgeSlam(const PinholeCamera& camera, SlamOptions options, std::unique_ptr<EdgeLink> link);
   ~EdgeSlam() override;

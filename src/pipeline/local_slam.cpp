@@ -3,7 +3,7 @@
 namespace edgeslam {
 
 LocalSlam::LocalSlam(const PinholeCamera& camera, SlamOptions options)
-    : SlamSystem(camera, std::move(options), 0) {
+    : TrackingSlam(camera, std::move(options), 0) {
   mapper_ = std::make_unique<LocalMapper>(map_, camera_, options_.mapper);
   startTracking(mapper_.get());
   if (options_.threaded_mapping) mapper_->start();

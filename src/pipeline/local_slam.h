@@ -8,7 +8,7 @@
 
 namespace edgeslam {
 
-class LocalSlam : public SlamSystem {
+class LocalSlam : public TrackingSlam {
  public:
   LocalSlam(const PinholeCamera& camera, SlamOptions options);
   ~LocalSlam() override;

@@ -26,18 +26,19 @@ SlamOptions defaultSlamOptions(const PinholeCamera& camera, Sensor sensor) {
   return options;
 }
 
-SlamSystem::SlamSystem(const PinholeCamera& camera, SlamOptions options, std::uint8_t map_id_origin)
+TrackingSlam::TrackingSlam(const PinholeCamera& camera, SlamOptions options,
+                           std::uint8_t map_id_origin)
     : camera_(camera), options_(std::move(options)), extractor_(options_.orb), map_(map_id_origin) {
   options_.tracker.sensor = options_.sensor;
   options_.mapper.monocular = options_.sensor == Sensor::kMonocular;
 }
 
-void SlamSystem::startTracking(KeyFrameSink* sink) {
+void TrackingSlam::startTracking(KeyFrameSink* sink) {
   tracker_ = std::make_unique<Tracker>(map_, camera_, options_.tracker, sink);
 }
 
-TrackResult SlamSystem::process(std::size_t frame_index, double timestamp, const cv::Mat& gray,
-                                const cv::Mat& depth) {
+TrackResult TrackingSlam::process(std::size_t frame_index, double timestamp, const cv::Mat& gray,
+                                  const cv::Mat& depth) {
   const cv::Mat& used_depth = options_.sensor == Sensor::kMonocular ? cv::Mat() : depth;
   auto features = buildFrameFeatures(gray, used_depth, camera_, extractor_, options_.depth);
   TrackResult result = tracker_->track(frame_index, timestamp, std::move(features));
@@ -45,7 +46,7 @@ TrackResult SlamSystem::process(std::size_t frame_index, double timestamp, const
   return result;
 }
 
-Trajectory SlamSystem::trajectoryAtFrameTime() const {
+Trajectory TrackingSlam::trajectoryAtFrameTime() const {
   Trajectory out;
   for (const auto& r : tracker_->records()) {
     if (r.tracked) out.push_back({r.timestamp, r.T_cw.inverse()});
@@ -53,7 +54,7 @@ Trajectory SlamSystem::trajectoryAtFrameTime() const {
   return out;
 }
 
-Trajectory SlamSystem::trajectoryFinal() const {
+Trajectory TrackingSlam::trajectoryFinal() const {
   std::lock_guard lock(map_.updateMutex());
   Trajectory out;
   for (const auto& r : tracker_->records()) {
@@ -63,19 +64,19 @@ Trajectory SlamSystem::trajectoryFinal() const {
   return out;
 }
 
-Trajectory SlamSystem::keyframeTrajectory() const {
+Trajectory TrackingSlam::keyframeTrajectory() const {
   std::lock_guard lock(map_.updateMutex());
   Trajectory out;
   for (KeyFrame* kf : map_.keyFrames()) out.push_back({kf->timestamp(), kf->poseInverse()});
   return out;
 }
 
-std::size_t SlamSystem::keyFrameCount() const {
+std::size_t TrackingSlam::keyFrameCount() const {
   std::lock_guard lock(map_.updateMutex());
   return map_.keyFrameCount();
 }
 
-std::size_t SlamSystem::mapPointCount() const {
+std::size_t TrackingSlam::mapPointCount() const {
   std::lock_guard lock(map_.updateMutex());
   return map_.pointCount();
 }

@@ -41,34 +41,53 @@ struct SlamCounters {
   PercentileSummary slice_apply_ms;
 };
 
+// One run mode's whole SLAM as the run command drives it.
 class SlamSystem {
  public:
   virtual ~SlamSystem() = default;
-  SlamSystem(const SlamSystem&) = delete;
-  SlamSystem& operator=(const SlamSystem&) = delete;
 
   // `depth` is CV_32FC1 metres (RGB-D) or empty.
-  TrackResult process(std::size_t frame_index, double timestamp, const cv::Mat& gray,
-                      const cv::Mat& depth);
+  virtual TrackResult process(std::size_t frame_index, double timestamp, const cv::Mat& gray,
+                              const cv::Mat& depth) = 0;
   // Lets mapping finish its backlog (call before reading the final trajectory).
   virtual void finish() = 0;
   virtual SlamCounters counters() const { return {}; }
   virtual const char* modeName() const = 0;
 
   // Pose of every tracked frame as it was estimated at that frame's time.
-  Trajectory trajectoryAtFrameTime() const;
+  virtual Trajectory trajectoryAtFrameTime() const = 0;
   // Every tracked frame relative to its reference keyframe's final pose.
-  Trajectory trajectoryFinal() const;
-  Trajectory keyframeTrajectory() const;
+  virtual Trajectory trajectoryFinal() const = 0;
+  virtual Trajectory keyframeTrajectory() const = 0;
+  virtual std::size_t keyFrameCount() const = 0;
+  virtual std::size_t mapPointCount() const = 0;
+  virtual std::size_t relocalizations() const = 0;
+  virtual std::size_t mapResets() const = 0;
+};
+
+// Modes that track on the client against the client's map: feature extraction and tracking on the
+// caller's thread; subclasses decide where keyframes go.
+class TrackingSlam : public SlamSystem {
+ public:
+  TrackingSlam(const TrackingSlam&) = delete;
+  TrackingSlam& operator=(const TrackingSlam&) = delete;
+
+  TrackResult process(std::size_t frame_index, double timestamp, const cv::Mat& gray,
+                      const cv::Mat& depth) override;
+  Trajectory trajectoryAtFrameTime() const override;
+  Trajectory trajectoryFinal() const override;
+  Trajectory keyframeTrajectory() const override;
+  std::size_t keyFrameCount() const override;
+  std::size_t mapPointCount() const override;
+  std::size_t relocalizations() const override { return tracker_->relocalizations(); }
+  std::size_t mapResets() const override { return tracker_->resets(); }
 
   const Tracker& tracker() const { return *tracker_; }
   // The client's map (lock its update mutex while reading it during a run).
   const Map& map() const { return map_; }
-  std::size_t keyFrameCount() const;
-  std::size_t mapPointCount() const;
 
  protected:
-  SlamSystem(const PinholeCamera& camera, SlamOptions options, std::uint8_t map_id_origin);
+  TrackingSlam(const PinholeCamera& camera, SlamOptions options, std::uint8_t map_id_origin);
   void startTracking(KeyFrameSink* sink);
   virtual void afterFrame() {}
 

@@ -1,0 +1,43 @@
+#pragma once
+// CenterNet object detector (MobileNetV3, COCO 80 classes) on OpenCV DNN: class heat-map peaks
+// (3x3 local maxima) plus left/top/right/bottom distances on the stride-4 grid, then class-aware
+// box NMS.
+#include <filesystem>
+#include <opencv2/core.hpp>
+#include <opencv2/dnn.hpp>
+#include <vector>
+
+namespace edgeslam {
+
+struct Detection {
+  int class_id = -1;
+  float score = 0.0f;
+  cv::Rect2f box;  // image pixels, clipped to the image
+};
+
+struct CenterNetOptions {
+  float score_threshold = 0.3f;
+  float nms_threshold = 0.8f;
+  std::vector<int> classes;  // keep only these COCO ids; empty = all 80
+};
+
+class CenterNetDetector {
+ public:
+  // Throws std::runtime_error naming the file when it is missing or not a CenterNet network.
+  explicit CenterNetDetector(const std::filesystem::path& model_file);
+
+  std::vector<Detection> detect(const cv::Mat& bgr, const CenterNetOptions& options);
+
+  static constexpr int kInputSize = 512;
+  static constexpr int kStride = 4;
+
+ private:
+  cv::dnn::Net net_;
+  std::vector<cv::String> output_names_;
+};
+
+// Class-aware NMS: within each class, a box overlapping a higher-scoring one by IoU > threshold is
+// dropped. Returns the survivors, highest score first.
+std::vector<Detection> classAwareNms(std::vector<Detection> detections, float iou_threshold);
+
+}  // namespace edgeslam

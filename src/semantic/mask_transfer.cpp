@@ -1,0 +1,247 @@
+#include "semantic/mask_transfer.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+namespace edgeslam {
+namespace {
+
+constexpr int kLabels = 256;
+
+struct InstanceExtent {
+  int min_x = INT32_MAX, min_y = INT32_MAX, max_x = -1, max_y = -1;
+  bool present() const { return max_x >= 0; }
+  cv::Rect rect() const { return {min_x, min_y, max_x - min_x + 1, max_y - min_y + 1}; }
+};
+
+std::array<InstanceExtent, kLabels> instanceExtents(const cv::Mat1b& labels) {
+  std::array<InstanceExtent, kLabels> extents;
+  for (int y = 0; y < labels.rows; ++y) {
+    const std::uint8_t* row = labels.ptr<std::uint8_t>(y);
+    for (int x = 0; x < labels.cols; ++x) {
+      if (row[x] == 0) continue;
+      InstanceExtent& e = extents[row[x]];
+      e.min_x = std::min(e.min_x, x);
+      e.max_x = std::max(e.max_x, x);
+      e.min_y = std::min(e.min_y, y);
+      e.max_y = std::max(e.max_y, y);
+    }
+  }
+  return extents;
+}
+
+// Label within `margin` of (x, y), 0 when none.
+std::uint8_t labelNear(const cv::Mat1b& labels, int x, int y, int margin) {
+  const cv::Rect window = cv::Rect(x - margin, y - margin, 2 * margin + 1, 2 * margin + 1) &
+                          cv::Rect(0, 0, labels.cols, labels.rows);
+  for (int row = window.y; row < window.y + window.height; ++row) {
+    const std::uint8_t* pixels = labels.ptr<std::uint8_t>(row);
+    for (int col = window.x; col < window.x + window.width; ++col) {
+      if (pixels[col] != 0) return pixels[col];
+    }
+  }
+  return 0;
+}
+
+double median(std::vector<double> values) {
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
+cv::Matx23d translation(double tx, double ty) {
+  return cv::Matx23d(1, 0, tx, 0, 1, ty);
+}
+
+// Fits the motion of one set of matched points by the rules in mask_transfer.h; `fallback` is used
+// when there are no matches.
+TransferredInstance fitMotion(const std::vector<cv::Point2f>& from,
+                              const std::vector<cv::Point2f>& to,
+                              const MaskTransferOptions& options,
+                              const TransferredInstance& fallback) {
+  TransferredInstance fit = fallback;
+  fit.matches = static_cast<int>(from.size());
+  fit.inliers = 0;
+  if (from.empty()) return fit;
+  if (static_cast<int>(from.size()) >= options.min_matches_for_warp) {
+    std::vector<std::uint8_t> inlier_flags;
+    const cv::Mat warp =
+        cv::estimateAffinePartial2D(from, to, inlier_flags, cv::RANSAC, options.ransac_threshold_px,
+                                    static_cast<std::size_t>(options.ransac_iterations), 0.99, 10);
+    if (!warp.empty()) {
+      const int inliers = cv::countNonZero(inlier_flags);
+      const double scale = std::hypot(warp.at<double>(0, 0), warp.at<double>(1, 0));
+      const bool plausible_scale =
+          scale <= options.max_scale_change && scale * options.max_scale_change >= 1.0;
+      if (plausible_scale && inliers >= 3 &&
+          inliers >= options.min_inlier_ratio * static_cast<double>(from.size())) {
+        fit.motion = InstanceMotion::kSimilarity;
+        fit.warp = cv::Matx23d(warp.ptr<double>());
+        fit.inliers = inliers;
+        return fit;
+      }
+    }
+  }
+  std::vector<double> dx, dy;
+  dx.reserve(from.size());
+  dy.reserve(from.size());
+  for (std::size_t i = 0; i < from.size(); ++i) {
+    dx.push_back(to[i].x - from[i].x);
+    dy.push_back(to[i].y - from[i].y);
+  }
+  fit.motion = InstanceMotion::kTranslation;
+  fit.warp = translation(median(dx), median(dy));
+  fit.inliers = fit.matches;
+  return fit;
+}
+
+// Paints the pixels of `label` inside `source_box` of `source`, moved by `warp`, into `target`.
+void paintWarped(const cv::Mat1b& source, std::uint8_t label, const cv::Rect& source_box,
+                 const cv::Matx23d& warp, cv::Mat1b& target) {
+  std::array<cv::Point2f, 4> corners;
+  const std::array<cv::Point2d, 4> box_corners = {
+      cv::Point2d(source_box.x, source_box.y), cv::Point2d(source_box.br().x, source_box.y),
+      cv::Point2d(source_box.x, source_box.br().y),
+      cv::Point2d(source_box.br().x, source_box.br().y)};
+  for (std::size_t i = 0; i < 4; ++i) {
+    const cv::Point2d& c = box_corners[i];
+    corners[i] = cv::Point2f(static_cast<float>(warp(0, 0) * c.x + warp(0, 1) * c.y + warp(0, 2)),
+                             static_cast<float>(warp(1, 0) * c.x + warp(1, 1) * c.y + warp(1, 2)));
+  }
+  const cv::Rect target_box =
+      cv::boundingRect(std::vector<cv::Point2f>(corners.begin(), corners.end())) &
+      cv::Rect(0, 0, target.cols, target.rows);
+  if (target_box.empty()) return;
+  cv::Mat1b instance = source(source_box) == label;
+  // Maps source-box pixels to target-box pixels: shift into the image, warp, shift into the box.
+  const cv::Matx23d local(
+      warp(0, 0), warp(0, 1),
+      warp(0, 0) * source_box.x + warp(0, 1) * source_box.y + warp(0, 2) - target_box.x, warp(1, 0),
+      warp(1, 1),
+      warp(1, 0) * source_box.x + warp(1, 1) * source_box.y + warp(1, 2) - target_box.y);
+  cv::Mat1b moved;
+  cv::warpAffine(instance, moved, local, target_box.size(), cv::INTER_NEAREST, cv::BORDER_CONSTANT,
+                 cv::Scalar(0));
+  target(target_box).setTo(label, moved);
+}
+
+}  // namespace
+
+const char* toString(InstanceMotion motion) {
+  switch (motion) {
+    case InstanceMotion::kSimilarity:
+      return "similarity";
+    case InstanceMotion::kTranslation:
+      return "translation";
+    case InstanceMotion::kBackground:
+      return "background";
+    case InstanceMotion::kIdentity:
+      return "identity";
+  }
+  return "?";
+}
+
+MaskTransferResult transferLabels(const cv::Mat1b& keyframe_labels,
+                                  const std::vector<cv::Point2f>& keyframe_points,
+                                  const std::vector<cv::Point2f>& current_points,
+                                  const MaskTransferOptions& options) {
+  if (keyframe_points.size() != current_points.size()) {
+    throw std::invalid_argument("mask transfer needs matched point lists of equal length, got " +
+                                std::to_string(keyframe_points.size()) + " and " +
+                                std::to_string(current_points.size()));
+  }
+  if (keyframe_labels.empty()) throw std::invalid_argument("mask transfer of an empty label image");
+  MaskTransferResult result;
+  result.labels = cv::Mat1b::zeros(keyframe_labels.size());
+  result.mask = cv::Mat1b::zeros(keyframe_labels.size());
+  if (cv::countNonZero(keyframe_labels) == 0) return result;
+
+  const std::array<InstanceExtent, kLabels> extents = instanceExtents(keyframe_labels);
+  // Instance boxes grown by the margin: only points inside one need the (costlier) near search.
+  std::vector<cv::Rect> near_zones;
+  for (const InstanceExtent& extent : extents) {
+    if (!extent.present()) continue;
+    const int m = options.near_margin_px;
+    near_zones.push_back(extent.rect() + cv::Size(2 * m, 2 * m) - cv::Point(m, m));
+  }
+  auto inNearZone = [&](cv::Point p) {
+    return std::any_of(near_zones.begin(), near_zones.end(),
+                       [&](const cv::Rect& zone) { return zone.contains(p); });
+  };
+  std::array<std::vector<int>, kLabels> on_instance, near_instance;
+  std::vector<int> background;
+  const cv::Rect image(0, 0, keyframe_labels.cols, keyframe_labels.rows);
+  for (std::size_t i = 0; i < keyframe_points.size(); ++i) {
+    const int x = cvFloor(keyframe_points[i].x), y = cvFloor(keyframe_points[i].y);
+    if (!image.contains(cv::Point(x, y))) continue;
+    const std::uint8_t label = keyframe_labels(y, x);
+    if (label != 0) {
+      on_instance[label].push_back(static_cast<int>(i));
+      continue;
+    }
+    background.push_back(static_cast<int>(i));
+    if (options.near_margin_px <= 0 || !inNearZone(cv::Point(x, y))) continue;
+    const std::uint8_t near = labelNear(keyframe_labels, x, y, options.near_margin_px);
+    if (near != 0) near_instance[near].push_back(static_cast<int>(i));
+  }
+
+  auto gather = [&](const std::vector<int>& indices, std::vector<cv::Point2f>& from,
+                    std::vector<cv::Point2f>& to) {
+    for (int index : indices) {
+      from.push_back(keyframe_points[static_cast<std::size_t>(index)]);
+      to.push_back(current_points[static_cast<std::size_t>(index)]);
+    }
+  };
+  std::vector<cv::Point2f> from, to;
+  gather(background, from, to);
+  TransferredInstance identity;
+  result.background = fitMotion(from, to, options, identity);
+  TransferredInstance background_fallback = result.background;
+  if (background_fallback.motion != InstanceMotion::kIdentity) {
+    background_fallback.motion = InstanceMotion::kBackground;
+  }
+
+  for (int label = kLabels - 1; label >= 1; --label) {  // label 1 (best score) painted last
+    const InstanceExtent& extent = extents[static_cast<std::size_t>(label)];
+    if (!extent.present()) continue;
+    from.clear();
+    to.clear();
+    const auto& own = on_instance[static_cast<std::size_t>(label)];
+    gather(own.empty() ? near_instance[static_cast<std::size_t>(label)] : own, from, to);
+    TransferredInstance moved = fitMotion(from, to, options, background_fallback);
+    moved.label = static_cast<std::uint8_t>(label);
+    paintWarped(keyframe_labels, moved.label, extent.rect(), moved.warp, result.labels);
+    result.instances.push_back(moved);
+  }
+  std::reverse(result.instances.begin(), result.instances.end());
+  result.mask.setTo(255, result.labels);
+  return result;
+}
+
+MaskTransferResult transferMask(const cv::Mat1b& keyframe_mask,
+                                const std::vector<cv::Point2f>& keyframe_points,
+                                const std::vector<cv::Point2f>& current_points,
+                                const MaskTransferOptions& options) {
+  if (keyframe_mask.empty()) throw std::invalid_argument("mask transfer of an empty mask");
+  // Fragments closer than the gap (a person's mask split at the waist) form one instance.
+  cv::Mat1b grouped;  // not a view of keyframe_mask: dilate would write into the caller's mask
+  if (options.merge_gap_px <= 0) {
+    grouped = keyframe_mask;
+  } else {
+    const int size = 2 * options.merge_gap_px + 1;
+    cv::dilate(keyframe_mask, grouped,
+               cv::getStructuringElement(cv::MORPH_RECT, cv::Size(size, size)));
+  }
+  cv::Mat1i components;
+  cv::connectedComponents(grouped, components, 8, CV_32S);
+  cv::Mat1b labels;
+  components.convertTo(labels, CV_8U);  // saturates: components past 255 share label 255
+  labels.setTo(0, keyframe_mask == 0);
+  return transferLabels(labels, keyframe_points, current_points, options);
+}
+
+}  // namespace edgeslam

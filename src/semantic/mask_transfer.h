@@ -1,0 +1,68 @@
+#pragma once
+// Semantic mask transfer (paper Sec. IV-C, Fig. 9), improved: instead of copying the keyframe's
+// mask, each instance is moved by its own motion, fitted to the feature matches that lie on it.
+//
+// Per instance (label) of the keyframe's label image, with the matches whose keyframe point lies
+// on it (or, when none does, those within `near_margin_px` of it):
+//  - at least `min_matches_for_warp` matches: RANSAC similarity (rotation, uniform scale,
+//    translation) by cv::estimateAffinePartial2D; a fit with too few inliers or an implausible
+//    scale change falls back to the next rule;
+//  - at least one match: the median translation of those matches;
+//  - none: the background motion (a similarity fitted to the matches off every instance, or their
+//    median translation, or the identity when there are none).
+// The instance's pixels are warped (nearest neighbour, inside their bounding box only, so the cost
+// follows the instance size) and painted into the current frame's label image.
+//
+// The matches should be the raw keyframe -> current feature matches, including features on the
+// movable objects (before dynamic culling): those are what tell how the objects moved.
+#include <cstdint>
+#include <opencv2/core.hpp>
+#include <vector>
+
+namespace edgeslam {
+
+struct MaskTransferOptions {
+  int near_margin_px = 12;       // matches this close to an instance count when none lies on it
+  int min_matches_for_warp = 6;  // fewer: median translation instead of a similarity
+  double ransac_threshold_px = 3.0;
+  double min_inlier_ratio = 0.5;  // of the matches used for the similarity
+  double max_scale_change = 1.5;  // similarities scaling by more (or less than 1/this) are rejected
+  int ransac_iterations = 200;
+  int merge_gap_px = 4;  // transferMask: mask fragments closer than this move as one instance
+};
+
+enum class InstanceMotion { kSimilarity, kTranslation, kBackground, kIdentity };
+
+const char* toString(InstanceMotion motion);
+
+struct TransferredInstance {
+  std::uint8_t label = 0;
+  InstanceMotion motion = InstanceMotion::kIdentity;
+  cv::Matx23d warp = cv::Matx23d(1, 0, 0, 0, 1, 0);  // keyframe pixel -> current pixel
+  int matches = 0;                                   // matches used for the fit
+  int inliers = 0;
+};
+
+struct MaskTransferResult {
+  cv::Mat1b labels;  // current frame label image, same size and labels as the keyframe's
+  cv::Mat1b mask;    // union of the transferred instances, 255 inside
+  std::vector<TransferredInstance> instances;  // ascending label
+  TransferredInstance background;
+};
+
+// `keyframe_points[i]` matches `current_points[i]` (pixels). Throws std::invalid_argument when the
+// two lists differ in length.
+MaskTransferResult transferLabels(const cv::Mat1b& keyframe_labels,
+                                  const std::vector<cv::Point2f>& keyframe_points,
+                                  const std::vector<cv::Point2f>& current_points,
+                                  const MaskTransferOptions& options = {});
+
+// The same for a binary movable mask: its connected components (fragments closer than
+// `merge_gap_px` joined) are taken as the instances. Prefer transferLabels with the segmenter's
+// label image where it is available: overlapping instances stay apart.
+MaskTransferResult transferMask(const cv::Mat1b& keyframe_mask,
+                                const std::vector<cv::Point2f>& keyframe_points,
+                                const std::vector<cv::Point2f>& current_points,
+                                const MaskTransferOptions& options = {});
+
+}  // namespace edgeslam

@@ -1,0 +1,46 @@
+// `edgeslam segment` as a user runs it.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+
+#include "support/edgeslam_command.h"
+#include "support/shared_data.h"
+
+namespace edgeslam {
+namespace {
+
+namespace fs = std::filesystem;
+
+TEST(SegmentCommand, WritesAnOverlayAndListsThePeople) {
+  EDGESLAM_REQUIRE_SHARED("datasets/people/zidane.jpg");
+  EDGESLAM_REQUIRE_SHARED("models");
+  const fs::path out = fs::temp_directory_path() / "edgeslam_segment_zidane.png";
+  fs::remove(out);
+  const auto result = test::runEdgeslam(
+      "segment --image " + test::sharedPath("datasets/people/zidane.jpg").string() + " --models " +
+      test::sharedPath("models").string() + " --out " + out.string() + " --classes person");
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  EXPECT_NE(result.output.find("2 instances"), std::string::npos) << result.output;
+  EXPECT_NE(result.output.find("person"), std::string::npos);
+  const cv::Mat overlay = cv::imread(out.string());
+  EXPECT_EQ(overlay.size(), cv::Size(1280, 720));
+  fs::remove(out);
+}
+
+TEST(SegmentCommand, BadInputGivesAClearError) {
+  auto result = test::runEdgeslam("segment --image /nonexistent.jpg --models /nonexistent/models");
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("/nonexistent/models/centernet_mbv3_coco_512.onnx"),
+            std::string::npos)
+      << result.output;
+  result = test::runEdgeslam("segment --image x.jpg --classes person,unicorn");
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("unicorn"), std::string::npos) << result.output;
+  result = test::runEdgeslam("segment");
+  EXPECT_NE(result.exit_code, 0);
+  EXPECT_NE(result.output.find("--image"), std::string::npos) << result.output;
+}
+
+}  // namespace
+}  // namespace edgeslam

@@ -1,0 +1,190 @@
+// The CenterNet + selfie segmenter on the shared photos of people (label data).
+#include <gtest/gtest.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "people_photos.h"
+#include "semantic/coco_classes.h"
+#include "semantic/label_encoding.h"
+#include "support/shared_data.h"
+
+namespace edgeslam {
+namespace {
+
+using test::segmentedPhoto;
+
+double boxIou(const cv::Rect& a, const cv::Rect& b) {
+  const double intersection = (a & b).area();
+  return intersection / (a.area() + b.area() - intersection);
+}
+
+std::vector<const SegmentedInstance*> ofClass(const Segmentation& s, const std::string& name) {
+  std::vector<const SegmentedInstance*> out;
+  for (const auto& instance : s.instances) {
+    if (instance.class_name == name) out.push_back(&instance);
+  }
+  return out;
+}
+
+// The instance of `name` that best overlaps `expected`, with its IoU.
+std::pair<const SegmentedInstance*, double> bestMatch(const Segmentation& s,
+                                                      const std::string& name,
+                                                      const cv::Rect& expected) {
+  std::pair<const SegmentedInstance*, double> best{nullptr, 0.0};
+  for (const auto* instance : ofClass(s, name)) {
+    const double iou = boxIou(instance->box, expected);
+    if (iou > best.second) best = {instance, iou};
+  }
+  return best;
+}
+
+// A well-visible person: pixel mask, covering a plausible part of the box.
+void expectPersonMask(const SegmentedInstance& person) {
+  EXPECT_FALSE(person.mask_is_box) << "box " << person.box;
+  const double coverage = static_cast<double>(cv::countNonZero(person.mask)) / person.box.area();
+  EXPECT_GT(coverage, 0.25) << "box " << person.box;
+  EXPECT_LT(coverage, 0.9) << "box " << person.box;
+  EXPECT_EQ(cv::countNonZero(person.mask(person.box)), cv::countNonZero(person.mask))
+      << "mask leaves its box";
+}
+
+void expectConsistent(const Segmentation& s, cv::Size size) {
+  ASSERT_EQ(s.movable_mask.size(), size);
+  ASSERT_EQ(s.label_image.size(), size);
+  cv::Mat1b united = cv::Mat1b::zeros(size);
+  for (const auto& instance : s.instances) united |= instance.mask;
+  EXPECT_EQ(cv::countNonZero(united != s.movable_mask), 0);
+  EXPECT_EQ(cv::countNonZero((s.label_image > 0) != (s.movable_mask > 0)), 0);
+  for (std::size_t i = 1; i < s.instances.size(); ++i) {
+    EXPECT_GE(s.instances[i - 1].score, s.instances[i].score);
+  }
+  EXPECT_GT(s.elapsed_ms, 0.0);
+}
+
+TEST(SegmenterData, BusPhotoHasThreeWalkersAndTheBus) {
+  EDGESLAM_REQUIRE_SHARED("datasets/people/bus.jpg");
+  EDGESLAM_REQUIRE_SHARED("models");
+  const auto& photo = segmentedPhoto("bus.jpg");
+  const Segmentation& s = photo.segmentation;
+  expectConsistent(s, photo.image.size());
+  const auto people = ofClass(s, "person");
+  EXPECT_GE(people.size(), 3u);
+  EXPECT_LE(people.size(), 5u);  // a fourth person is cut by the left border
+  // Hand-checked boxes (x, y, w, h) of the three walkers and the bus, with margin.
+  for (const cv::Rect expected :
+       {cv::Rect(50, 400, 170, 505), cv::Rect(215, 410, 135, 445), cv::Rect(670, 340, 140, 545)}) {
+    const auto [person, iou] = bestMatch(s, "person", expected);
+    ASSERT_NE(person, nullptr);
+    EXPECT_GT(iou, 0.7) << "person near " << expected;
+    expectPersonMask(*person);
+  }
+  const auto [bus, bus_iou] = bestMatch(s, "bus", cv::Rect(15, 220, 775, 515));
+  ASSERT_NE(bus, nullptr);
+  EXPECT_GT(bus_iou, 0.7);
+  EXPECT_TRUE(bus->mask_is_box);
+  // The people in front of the bus keep their own label over the bus box.
+  const auto [walker, walker_iou] = bestMatch(s, "person", cv::Rect(215, 410, 135, 445));
+  ASSERT_NE(walker, nullptr);
+  const std::size_t walker_index = static_cast<std::size_t>(walker - s.instances.data());
+  const cv::Mat1b walker_pixels = walker->mask & (s.label_image == instanceLabel(walker_index));
+  EXPECT_EQ(cv::countNonZero(walker_pixels), cv::countNonZero(walker->mask));
+}
+
+TEST(SegmenterData, ZidanePhotoHasTwoPeople) {
+  EDGESLAM_REQUIRE_SHARED("datasets/people/zidane.jpg");
+  EDGESLAM_REQUIRE_SHARED("models");
+  const auto& photo = segmentedPhoto("zidane.jpg");
+  expectConsistent(photo.segmentation, photo.image.size());
+  const auto people = ofClass(photo.segmentation, "person");
+  ASSERT_EQ(people.size(), 2u);
+  // The man on the right (box hand-checked) and the one on the left, whose head is near (560, 260).
+  const auto [right, right_iou] = bestMatch(photo.segmentation, "person", {745, 45, 390, 665});
+  ASSERT_NE(right, nullptr);
+  EXPECT_GT(right_iou, 0.7);
+  expectPersonMask(*right);
+  const SegmentedInstance* left = people[0] == right ? people[1] : people[0];
+  EXPECT_TRUE(left->box.contains({560, 260}));
+  EXPECT_TRUE(left->box.contains({300, 600}));
+  EXPECT_FALSE(left->mask_is_box);
+  EXPECT_NE(left->mask(260, 560), 0) << "the left man's head";
+  EXPECT_EQ(photo.segmentation.movable_mask(100, 100), 0) << "the crowd behind is background";
+}
+
+TEST(SegmenterData, StreetPhotoHasThePedestrianAndCars) {
+  EDGESLAM_REQUIRE_SHARED("datasets/people/street.jpg");
+  EDGESLAM_REQUIRE_SHARED("models");
+  const auto& photo = segmentedPhoto("street.jpg");
+  expectConsistent(photo.segmentation, photo.image.size());
+  const auto [walker, iou] = bestMatch(photo.segmentation, "person", {1895, 935, 305, 765});
+  ASSERT_NE(walker, nullptr);
+  EXPECT_GT(iou, 0.7);
+  expectPersonMask(*walker);
+  EXPECT_GE(ofClass(photo.segmentation, "car").size(), 3u);
+  const auto [parked, parked_iou] = bestMatch(photo.segmentation, "car", {0, 1045, 640, 500});
+  EXPECT_GT(parked_iou, 0.7);
+  // The sky and the crossing in front are background.
+  EXPECT_EQ(photo.segmentation.movable_mask(200, 1280), 0);
+  EXPECT_EQ(photo.segmentation.movable_mask(1800, 1280), 0);
+}
+
+TEST(SegmenterData, LabelImageOfAPhotoIsSmallOnTheWire) {
+  EDGESLAM_REQUIRE_SHARED("datasets/people/bus.jpg");
+  EDGESLAM_REQUIRE_SHARED("models");
+  const auto& photo = segmentedPhoto("bus.jpg");
+  std::string encoding;
+  const auto bytes = encodeLabelImage(photo.segmentation.label_image, 2, encoding);
+  EXPECT_LT(bytes.size(), 8000u);
+  const cv::Mat1b decoded = decodeLabelImage(bytes, encoding, photo.image.size());
+  const cv::Mat1b agree = decoded == photo.segmentation.label_image;
+  EXPECT_GT(static_cast<double>(cv::countNonZero(agree)) / agree.total(), 0.99);
+  // The same masks at the 640x480 of a typical SLAM frame.
+  cv::Mat1b vga;
+  cv::resize(photo.segmentation.label_image, vga, {640, 480}, 0, 0, cv::INTER_NEAREST);
+  for (int downscale : {1, 2, 4}) {
+    std::printf("[ encoding ] bus.jpg labels at 640x480, downscale %d: %zu bytes\n", downscale,
+                encodeLabelImage(vga, downscale, encoding).size());
+  }
+}
+
+TEST(SegmenterData, ClassListAndGreyInput) {
+  EDGESLAM_REQUIRE_SHARED("datasets/people/bus.jpg");
+  EDGESLAM_REQUIRE_SHARED("models");
+  SegmenterOptions options;
+  options.model_dir = test::sharedPath("models");
+  options.classes = parseClassList("bus");
+  const auto segmenter = makeSegmenter(options);
+  cv::Mat grey;
+  cv::cvtColor(segmentedPhoto("bus.jpg").image, grey, cv::COLOR_BGR2GRAY);
+  const Segmentation s = segmenter->segment(grey);
+  ASSERT_GE(s.instances.size(), 1u);
+  for (const auto& instance : s.instances) EXPECT_EQ(instance.class_name, "bus");
+}
+
+TEST(SegmenterData, MissingPersonModelNamesTheFile) {
+  EDGESLAM_REQUIRE_SHARED("models/centernet_mbv3_coco_512.onnx");
+  SegmenterOptions options;
+  options.model_dir = test::sharedPath("models");
+  options.person_mask_model = "/nonexistent/selfie.onnx";
+  try {
+    makeSegmenter(options);
+    FAIL() << "expected an exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("/nonexistent/selfie.onnx"), std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(SegmenterData, ThresholdsAreSettableAndChecked) {
+  EDGESLAM_REQUIRE_SHARED("models");
+  auto& segmenter = test::sharedSegmenter();
+  const float nm = segmenter.nmsThreshold();
+  segmenter.setNmsThreshold(0.6f);
+  EXPECT_FLOAT_EQ(segmenter.nmsThreshold(), 0.6f);
+  EXPECT_THROW(segmenter.setNmsThreshold(1.5f), std::invalid_argument);
+  EXPECT_THROW(segmenter.setScoreThreshold(-0.1f), std::invalid_argument);
+  segmenter.setNmsThreshold(nm);
+}
+
+}  // namespace
+}  // namespace edgeslam
