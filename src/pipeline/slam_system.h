@@ -39,6 +39,7 @@ struct SlamCounters {
   std::uint64_t loops = 0;
   PercentileSummary slice_latency_ms;
   PercentileSummary slice_apply_ms;
+  PercentileSummary edge_frame_ms;  // offload: the edge's time per frame
 };
 
 // One run mode's whole SLAM as the run command drives it.

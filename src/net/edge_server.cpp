@@ -1,0 +1,118 @@
+#include "net/edge_server.h"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <condition_variable>
+#include <mutex>
+#include <stdexcept>
+#include <thread>
+
+#include "net/channel_options.h"
+#include "net/edge_service.h"
+
+namespace edgeslam {
+
+struct EdgeServer::Impl {
+  Impl(const std::string& listen_address, std::shared_ptr<EdgeSessionFactory> session_factory,
+       EdgeServerLimits server_limits)
+      : limits(server_limits),
+        registry(server_limits.max_sessions,
+                 SliceQueueLimits{server_limits.max_kept_slices, server_limits.max_kept_slice_bytes,
+                                  server_limits.max_send_message_bytes}),
+        service(registry, std::move(session_factory), server_limits) {
+    grpc::ServerBuilder builder;
+    builder.AddListeningPort(listen_address, grpc::InsecureServerCredentials(), &bound_port);
+    builder.RegisterService(&service);
+    applyServerChannelOptions(builder, limits.max_message_bytes, limits.max_send_message_bytes);
+    server = builder.BuildAndStart();
+    if (server == nullptr || bound_port == 0) {
+      throw std::runtime_error(fmt::format(
+          "edge server: cannot listen at '{}' (address in use or malformed?)", listen_address));
+    }
+    const std::size_t colon = listen_address.rfind(':');
+    host = colon == std::string::npos ? listen_address : listen_address.substr(0, colon);
+    reaper = std::thread([this] { reapIdleSessions(); });
+    spdlog::info("edge server: listening at {}:{}", host, bound_port);
+  }
+
+  void reapIdleSessions() {
+    const auto period = std::min<std::chrono::milliseconds>(
+        std::chrono::milliseconds(500),
+        std::max<std::chrono::milliseconds>(limits.idle_timeout / 4,
+                                            std::chrono::milliseconds(10)));
+    std::unique_lock lock(reaper_mutex);
+    while (!stopping) {
+      reaper_wake.wait_for(lock, period, [&] { return stopping; });
+      if (stopping) break;
+      lock.unlock();
+      const std::size_t closed = registry.closeIdle(limits.idle_timeout);
+      if (closed > 0) {
+        spdlog::info("edge server: closed {} idle session(s)", closed);
+      }
+      lock.lock();
+    }
+  }
+
+  void shutdown() {
+    {
+      std::lock_guard lock(reaper_mutex);
+      if (stopping) return;
+      stopping = true;
+    }
+    reaper_wake.notify_all();
+    service.stop();
+    registry.closeAll();  // wakes every waiting stream
+    server->Shutdown(std::chrono::system_clock::now() + std::chrono::seconds(1));
+    server->Wait();
+    if (reaper.joinable()) reaper.join();
+    spdlog::info("edge server: stopped");
+  }
+
+  const EdgeServerLimits limits;
+  SessionRegistry registry;
+  EdgeService service;
+  std::unique_ptr<grpc::Server> server;
+  int bound_port = 0;
+  std::string host;
+  std::thread reaper;
+  std::mutex reaper_mutex;
+  std::condition_variable reaper_wake;
+  bool stopping = false;
+};
+
+EdgeServer::EdgeServer(const std::string& listen_address,
+                       std::shared_ptr<EdgeSessionFactory> factory, EdgeServerLimits limits) {
+  if (factory == nullptr) throw std::invalid_argument("edge server: no session factory given");
+  impl_ = std::make_unique<Impl>(listen_address, std::move(factory), limits);
+}
+
+EdgeServer::~EdgeServer() {
+  shutdown();
+}
+
+int EdgeServer::port() const {
+  return impl_->bound_port;
+}
+
+std::string EdgeServer::address() const {
+  return fmt::format("{}:{}", impl_->host, impl_->bound_port);
+}
+
+void EdgeServer::shutdown() {
+  impl_->shutdown();
+}
+
+std::vector<SessionStats> EdgeServer::sessions() const {
+  return impl_->registry.stats();
+}
+
+std::size_t EdgeServer::sessionCount() const {
+  return impl_->registry.size();
+}
+
+std::uint64_t EdgeServer::idleSessionsClosed() const {
+  return impl_->registry.idleClosed();
+}
+
+}  // namespace edgeslam

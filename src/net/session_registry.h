@@ -1,0 +1,85 @@
+#pragma once
+// The edge server's live sessions: id and id-origin allocation, lookup, idle clean-up.
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "net/edge_server.h"
+#include "net/slice_queue.h"
+
+namespace edgeslam {
+
+// One session's state on the server. Destruction order matters: the backend (which holds the
+// sink) goes before the slice queue.
+struct ServerSession {
+  ServerSession(SessionConfig session_config, SliceQueueLimits slice_limits)
+      : config(std::move(session_config)), slices(slice_limits) {}
+  ~ServerSession() { backend.reset(); }
+
+  void touch() {
+    last_activity_ns.store(std::chrono::steady_clock::now().time_since_epoch().count());
+  }
+
+  const SessionConfig config;
+  SliceQueue slices;
+  std::mutex backend_mutex;  // serialises calls into the backend
+  std::unique_ptr<EdgeSessionBackend> backend;
+  std::uint64_t last_upload_sequence = 0;  // guarded by backend_mutex
+
+  std::atomic<std::int64_t> last_activity_ns{0};
+  std::atomic<int> active_streams{0};
+  std::atomic<std::uint64_t> uplink_bytes{0};
+  std::atomic<std::uint64_t> downlink_bytes{0};
+  std::atomic<std::uint64_t> keyframes{0};
+  std::atomic<std::uint64_t> duplicate_uploads{0};
+  std::atomic<std::uint64_t> frames{0};
+  std::atomic<std::uint64_t> slices_sent{0};
+};
+
+class SessionRegistryFull : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+class SessionRegistry {
+ public:
+  explicit SessionRegistry(std::size_t max_sessions, SliceQueueLimits slice_limits);
+
+  // Picks a session id and an id origin (the preferred one when free), then asks the factory for
+  // a backend (without holding the registry lock: opening may be slow). Throws
+  // SessionRegistryFull, or whatever the factory throws.
+  std::shared_ptr<ServerSession> open(SessionConfig config, EdgeSessionFactory& factory);
+  std::shared_ptr<ServerSession> find(std::uint64_t session_id) const;
+  // Removes the session and closes its slice queue; false when unknown.
+  bool close(std::uint64_t session_id) { return close(session_id, false); }
+  // Closes sessions without an open stream whose last activity is older than `idle_timeout`.
+  std::size_t closeIdle(std::chrono::milliseconds idle_timeout);
+  void closeAll();
+
+  std::vector<SessionStats> stats() const;
+  std::size_t size() const;
+  std::uint64_t idleClosed() const { return idle_closed_.load(); }
+
+ private:
+  bool close(std::uint64_t session_id, bool idle);
+  std::uint8_t reserveOriginLocked(std::uint8_t preferred);
+
+  const std::size_t max_sessions_;
+  const SliceQueueLimits slice_limits_;
+  mutable std::mutex mutex_;
+  std::map<std::uint64_t, std::shared_ptr<ServerSession>> sessions_;
+  std::vector<bool> origin_in_use_ = std::vector<bool>(256, false);
+  std::size_t reserved_ = 0;  // origins taken, including sessions still being opened
+  std::uint8_t next_origin_ = 1;
+  std::mt19937_64 random_{std::random_device{}()};
+  std::atomic<std::uint64_t> idle_closed_{0};
+};
+
+}  // namespace edgeslam

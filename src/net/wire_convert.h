@@ -1,0 +1,50 @@
+#pragma once
+// Map records and session types <-> protobuf messages of proto/edgeslam/v1. Encoding fails only
+// for records that cannot be represented (descriptors not N x 32 bytes...); decoding validates
+// everything a peer could get wrong and throws WireError naming the element and field.
+#include <cstddef>
+
+#include "edgeslam/v1/edgeslam.pb.h"
+#include "edgeslam/v1/map_records.pb.h"
+#include "map/map_records.h"
+#include "net/wire_error.h"
+#include "net/wire_types.h"
+
+namespace edgeslam {
+
+struct WireEncodeOptions {
+  // Keypoint responses are not used after extraction; leave them out unless asked (4 bytes each).
+  // Keypoint sizes travel only when they differ from the ORB convention 31 * scale^octave.
+  bool keypoint_response = false;
+};
+
+void toProto(const SE3d& pose, v1::Pose* out);
+void toProto(const KeyFrameRecord& keyframe, v1::KeyFrame* out, const WireEncodeOptions& = {});
+void toProto(const MapPointRecord& point, v1::MapPoint* out);
+void toProto(const KeyFrameUpload& upload, v1::KeyFrameUpload* out, const WireEncodeOptions& = {});
+void toProto(const KeyFramePoseRecord& pose, v1::KeyFramePose* out);
+void toProto(const MaskRecord& mask, v1::Mask* out);
+void toProto(const MapSlice& slice, v1::MapSlice* out, const WireEncodeOptions& = {});
+// Fills client name, camera, sensor, settings and the preferred id origin (config.id_origin).
+void toProto(const SessionConfig& config, v1::OpenSessionRequest* out);
+void toProto(const OffloadFrame& frame, v1::OffloadFrameRequest* out);
+void toProto(const OffloadResult& result, v1::OffloadFrameReply* out);
+
+SE3d fromProto(const v1::Pose& pose);
+KeyFrameRecord fromProto(const v1::KeyFrame& keyframe);
+MapPointRecord fromProto(const v1::MapPoint& point);
+KeyFrameUpload fromProto(const v1::KeyFrameUpload& upload);
+KeyFramePoseRecord fromProto(const v1::KeyFramePose& pose);
+MaskRecord fromProto(const v1::Mask& mask);
+MapSlice fromProto(const v1::MapSlice& slice);
+// Client name, camera (validated by PinholeCamera), sensor, settings; id_origin = the preference.
+SessionConfig fromProto(const v1::OpenSessionRequest& request);
+OffloadFrame fromProto(const v1::OffloadFrameRequest& request);
+OffloadResult fromProto(const v1::OffloadFrameReply& reply);
+
+// Serialized size in bytes, for uplink / downlink accounting and docs.
+std::size_t wireSize(const google::protobuf::MessageLite& message);
+std::size_t wireSize(const KeyFrameUpload& upload, const WireEncodeOptions& = {});
+std::size_t wireSize(const MapSlice& slice, const WireEncodeOptions& = {});
+
+}  // namespace edgeslam

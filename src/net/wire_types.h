@@ -1,0 +1,54 @@
+#pragma once
+// Plain types of the wire that are not map records: what a session is opened with, and the
+// whole-frame offload of the Mask-SLAM baseline mode.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "geometry/camera.h"
+#include "geometry/se3.h"
+#include "map/sensor.h"
+
+namespace edgeslam {
+
+// The protocol version this build speaks (RequestHeader.protocol_version).
+constexpr std::uint32_t kWireProtocolVersion = 1;
+
+struct SessionSettings {
+  int features = 1000;
+  int pyramid_levels = 8;
+  double scale_factor = 1.2;
+  bool semantic = true;
+};
+
+// What a client opens a session with; id_origin and session_id are filled in by the server.
+struct SessionConfig {
+  std::string client_name;
+  PinholeCamera camera;
+  Sensor sensor = Sensor::kMonocular;
+  SessionSettings settings;
+  std::uint64_t session_id = 0;
+  std::uint8_t id_origin = 0;  // top byte of every id the client makes
+};
+
+// One whole frame sent to the edge (offload mode).
+struct OffloadFrame {
+  std::uint64_t frame_index = 0;
+  double timestamp = 0.0;
+  std::string image_encoding;  // "jpeg" or "png"
+  std::vector<std::uint8_t> image_bytes;
+  std::string depth_encoding;  // "" (none) or "png" (16-bit)
+  std::vector<std::uint8_t> depth_bytes;
+};
+
+enum class OffloadTrackingState { kNotInitialized, kOk, kLost };
+
+struct OffloadResult {
+  std::uint64_t frame_index = 0;
+  OffloadTrackingState state = OffloadTrackingState::kNotInitialized;
+  std::optional<SE3d> T_cw;  // camera-from-world when tracked
+  double server_ms = 0.0;    // time the edge spent on the frame
+};
+
+}  // namespace edgeslam

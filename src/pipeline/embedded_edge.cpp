@@ -1,0 +1,28 @@
+#include "pipeline/embedded_edge.h"
+
+namespace edgeslam {
+
+EmbeddedEdge::EmbeddedEdge(SlamSessionOptions options, std::optional<LinkSettings> link) {
+  server_ =
+      std::make_unique<EdgeServer>("127.0.0.1:0", std::make_shared<SlamSessionFactory>(options));
+  if (link) {
+    LinkEmulatorOptions emulator;
+    emulator.listen = {"127.0.0.1", 0};
+    emulator.target = {"127.0.0.1", static_cast<std::uint16_t>(server_->port())};
+    emulator.settings = *link;
+    emulator_ = std::make_unique<LinkEmulator>(emulator);
+    emulator_->start();
+  }
+}
+
+EmbeddedEdge::~EmbeddedEdge() {
+  if (emulator_) emulator_->stop();
+  server_->shutdown();
+}
+
+std::string EmbeddedEdge::clientAddress() const {
+  const int port = emulator_ ? emulator_->port() : server_->port();
+  return "127.0.0.1:" + std::to_string(port);
+}
+
+}  // namespace edgeslam

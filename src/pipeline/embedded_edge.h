@@ -1,0 +1,28 @@
+#pragma once
+// The edge server inside the `run` command: a gRPC server on loopback (any free port), optionally
+// behind the link emulator, so that one command exercises the real wire.
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "link/link_emulator.h"
+#include "net/edge_server.h"
+#include "pipeline/slam_session_backend.h"
+
+namespace edgeslam {
+
+class EmbeddedEdge {
+ public:
+  EmbeddedEdge(SlamSessionOptions options, std::optional<LinkSettings> link);
+  ~EmbeddedEdge();
+
+  // Where the client connects: the emulator when there is one, else the server.
+  std::string clientAddress() const;
+  EdgeServer& server() { return *server_; }
+
+ private:
+  std::unique_ptr<EdgeServer> server_;
+  std::unique_ptr<LinkEmulator> emulator_;
+};
+
+}  // namespace edgeslam

@@ -1,0 +1,35 @@
+#pragma once
+// The real split: keyframe uploads and map slices over gRPC to an edge server session.
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include "net/edge_client.h"
+#include "pipeline/edge_link.h"
+
+namespace edgeslam {
+
+class GrpcEdgeLink : public EdgeLink {
+ public:
+  // Connects and opens the session; throws EdgeClientError when the server cannot be reached.
+  GrpcEdgeLink(const std::string& server_address, SessionConfig config,
+               EdgeClientOptions options = {});
+  ~GrpcEdgeLink() override;
+
+  void send(KeyFrameUpload upload) override;
+  std::uint8_t idOrigin() const override { return client_->idOrigin(); }
+  void setSliceHandler(SliceHandler handler) override;
+  EdgeLinkCounters counters() const override;
+  void close() override;
+
+  EdgeClient& client() { return *client_; }
+
+ private:
+  void deliver(MapSlice slice);
+
+  std::mutex handler_mutex_;
+  SliceHandler handler_;
+  std::unique_ptr<EdgeClient> client_;
+};
+
+}  // namespace edgeslam

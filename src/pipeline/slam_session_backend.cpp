@@ -1,0 +1,93 @@
+#include "pipeline/slam_session_backend.h"
+
+#include <spdlog/spdlog.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <stdexcept>
+
+#include "net/wire_error.h"
+#include "pipeline/local_slam.h"
+#include "util/timing_stats.h"
+
+namespace edgeslam {
+namespace {
+
+cv::Mat decodeImage(const std::vector<std::uint8_t>& bytes, int flags, const char* what) {
+  if (bytes.empty()) return {};
+  cv::Mat image = cv::imdecode(bytes, flags);
+  if (image.empty()) throw std::invalid_argument(std::string("undecodable ") + what + " image");
+  return image;
+}
+
+OffloadTrackingState toOffloadState(TrackingState state) {
+  switch (state) {
+    case TrackingState::kOk:
+      return OffloadTrackingState::kOk;
+    case TrackingState::kLost:
+      return OffloadTrackingState::kLost;
+    default:
+      return OffloadTrackingState::kNotInitialized;
+  }
+}
+
+}  // namespace
+
+SlamSessionBackend::SlamSessionBackend(const SessionConfig& config, SliceSink& sink,
+                                       SlamSessionOptions options)
+    : config_(config), sink_(sink), options_(options) {}
+
+SlamSessionBackend::~SlamSessionBackend() {
+  if (mapping_) mapping_->stop();
+}
+
+void SlamSessionBackend::onKeyFrame(KeyFrameUpload upload) {
+  if (!mapping_) {
+    mapping_ = std::make_unique<EdgeMapSession>(
+        config_.camera, config_.sensor, options_.mapping, [this](MapSlice slice) {
+          try {
+            sink_.push(std::move(slice));
+          } catch (const std::exception& e) {
+            spdlog::error("session {}: slice not sent: {}", config_.session_id, e.what());
+          }
+        });
+  }
+  mapping_->onKeyFrame(upload);
+}
+
+std::optional<OffloadResult> SlamSessionBackend::onFrame(OffloadFrame frame) {
+  Stopwatch timer;
+  const cv::Mat gray = decodeImage(frame.image_bytes, cv::IMREAD_GRAYSCALE, "colour");
+  if (gray.empty()) throw std::invalid_argument("offloaded frame without an image");
+  cv::Mat depth;
+  if (config_.sensor != Sensor::kMonocular && !frame.depth_bytes.empty()) {
+    const cv::Mat raw = decodeImage(frame.depth_bytes, cv::IMREAD_UNCHANGED, "depth");
+    if (raw.type() != CV_16U) throw std::invalid_argument("offloaded depth must be 16-bit mm");
+    raw.convertTo(depth, CV_32F, 1.0 / 1000.0);
+  }
+  if (!offload_) {
+    SlamOptions slam_options = defaultSlamOptions(config_.camera, config_.sensor);
+    slam_options.orb.num_features = config_.settings.features;
+    slam_options.orb.num_levels = config_.settings.pyramid_levels;
+    slam_options.orb.scale_factor = config_.settings.scale_factor;
+    offload_ = std::make_unique<LocalSlam>(config_.camera, slam_options);
+  }
+  const TrackResult tracked = offload_->process(frame.frame_index, frame.timestamp, gray, depth);
+  OffloadResult result;
+  result.frame_index = frame.frame_index;
+  result.state = toOffloadState(tracked.state);
+  result.T_cw = tracked.T_cw;
+  result.server_ms = timer.elapsedMs();
+  return result;
+}
+
+std::unique_ptr<EdgeSessionBackend> SlamSessionFactory::open(const SessionConfig& config,
+                                                             SliceSink& sink) {
+  if (config.sensor == Sensor::kStereo) {
+    throw std::invalid_argument("stereo sessions are not supported yet");
+  }
+  spdlog::info("edge: session {} for '{}' ({}x{}, {})", config.session_id, config.client_name,
+               config.camera.width(), config.camera.height(), toString(config.sensor));
+  return std::make_unique<SlamSessionBackend>(config, sink, options_);
+}
+
+}  // namespace edgeslam

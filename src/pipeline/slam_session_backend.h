@@ -1,0 +1,42 @@
+#pragma once
+// What an edge server session does: in edge mode it keeps the client's global map (keyframe
+// uploads in, map slices out); in offload mode it runs the whole SLAM on the frames it is sent.
+#include <memory>
+#include <mutex>
+
+#include "edge/edge_map_session.h"
+#include "net/edge_server.h"
+#include "pipeline/slam_system.h"
+
+namespace edgeslam {
+
+struct SlamSessionOptions {
+  EdgeMapSessionOptions mapping;
+};
+
+class SlamSessionBackend : public EdgeSessionBackend {
+ public:
+  SlamSessionBackend(const SessionConfig& config, SliceSink& sink, SlamSessionOptions options);
+  ~SlamSessionBackend() override;
+
+  void onKeyFrame(KeyFrameUpload upload) override;
+  std::optional<OffloadResult> onFrame(OffloadFrame frame) override;
+
+ private:
+  SessionConfig config_;
+  SliceSink& sink_;
+  SlamSessionOptions options_;
+  std::unique_ptr<EdgeMapSession> mapping_;  // edge mode, made at the first keyframe
+  std::unique_ptr<SlamSystem> offload_;      // offload mode, made at the first frame
+};
+
+class SlamSessionFactory : public EdgeSessionFactory {
+ public:
+  explicit SlamSessionFactory(SlamSessionOptions options = {}) : options_(options) {}
+  std::unique_ptr<EdgeSessionBackend> open(const SessionConfig& config, SliceSink& sink) override;
+
+ private:
+  SlamSessionOptions options_;
+};
+
+}  // namespace edgeslam
