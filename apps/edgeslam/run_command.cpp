@@ -13,9 +13,12 @@
 #include "io/camera_file.h"
 #include "io/dataset.h"
 #include "io/trajectory.h"
+#include "link/link_settings.h"
 #include "pipeline/edge_slam.h"
-#include "pipeline/in_process_edge_link.h"
+#include "pipeline/embedded_edge.h"
+#include "pipeline/grpc_edge_link.h"
 #include "pipeline/local_slam.h"
+#include "pipeline/offload_slam.h"
 #include "progress_line.h"
 #include "run_options.h"
 #include "util/timing_stats.h"
@@ -61,13 +64,57 @@ Sensor toSensor(const std::string& name) {
   return Sensor::kMonocular;
 }
 
-std::unique_ptr<SlamSystem> makeSlamSystem(const std::string& mode, const PinholeCamera& camera,
-                                           const SlamOptions& options) {
-  if (mode == "local") return std::make_unique<LocalSlam>(camera, options);
-  EdgeMapSessionOptions edge_options;
-  edge_options.mapper = options.mapper;
-  auto link = std::make_unique<InProcessEdgeLink>(camera, options.sensor, edge_options);
-  return std::make_unique<EdgeSlam>(camera, options, std::move(link));
+// The edge the client talks to: a remote server (`client --server`), or one embedded in this
+// process on loopback, behind the link emulator when a profile is asked for.
+struct EdgeEndpoint {
+  std::unique_ptr<EmbeddedEdge> embedded;
+  std::string address;
+};
+
+EdgeEndpoint openEdge(const RunOptions& options) {
+  EdgeEndpoint edge;
+  if (!options.server_address.empty()) {
+    edge.address = options.server_address;
+    if (options.link != "none") {
+      spdlog::warn("--link applies to the embedded edge only; talking to {} directly",
+                   edge.address);
+    }
+    return edge;
+  }
+  std::optional<LinkSettings> link;
+  if (options.link != "none") link = linkProfile(options.link);
+  edge.embedded = std::make_unique<EmbeddedEdge>(SlamSessionOptions{}, link);
+  edge.address = edge.embedded->clientAddress();
+  spdlog::info("edge server on loopback, client connects to {}{}", edge.address,
+               link ? " through link " + link->describe() : std::string());
+  return edge;
+}
+
+SessionConfig sessionConfig(const PinholeCamera& camera, Sensor sensor,
+                            const SlamOptions& slam_options, bool semantic) {
+  SessionConfig config;
+  config.client_name = "edgeslam-client";
+  config.camera = camera;
+  config.sensor = sensor;
+  config.settings.features = slam_options.orb.num_features;
+  config.settings.pyramid_levels = slam_options.orb.num_levels;
+  config.settings.scale_factor = slam_options.orb.scale_factor;
+  config.settings.semantic = semantic;
+  return config;
+}
+
+std::unique_ptr<SlamSystem> makeSlamSystem(const RunOptions& options, const std::string& mode,
+                                           const PinholeCamera& camera, Sensor sensor,
+                                           const SlamOptions& slam_options,
+                                           const EdgeEndpoint& edge) {
+  if (mode == "local") return std::make_unique<LocalSlam>(camera, slam_options);
+  const SessionConfig config = sessionConfig(camera, sensor, slam_options, options.semantic);
+  if (mode == "offload") {
+    return std::make_unique<OffloadSlam>(sensor,
+                                         std::make_unique<EdgeClient>(edge.address, config));
+  }
+  auto link = std::make_unique<GrpcEdgeLink>(edge.address, config);
+  return std::make_unique<EdgeSlam>(camera, slam_options, std::move(link));
 }
 
 int runPipeline(const RunOptions& options) {
@@ -85,11 +132,7 @@ int runPipeline(const RunOptions& options) {
       options.max_frames > 0 ? std::min(options.max_frames, info.frame_count) : info.frame_count;
   spdlog::info("dataset {} ({}, {} frames, {} fps), camera {}", info.path.string(),
                toString(info.format), info.frame_count, info.fps, reader->camera().describe());
-  std::string mode = options.mode;
-  if (mode == "offload") {
-    spdlog::warn("--mode offload is not built yet: running edge mode");
-    mode = "edge";
-  }
+  const std::string mode = options.mode;
 
   SlamOptions slam_options = defaultSlamOptions(reader->camera(), sensor);
   if (options.features) slam_options.orb.num_features = *options.features;
@@ -104,8 +147,9 @@ int runPipeline(const RunOptions& options) {
   spdlog::info("{} ORB features, {} levels; keyframes fmin {} fmax {} alpha {} beta {}",
                slam_options.orb.num_features, slam_options.orb.num_levels, kf.fmin, kf.fmax,
                kf.alpha, kf.beta);
+  const EdgeEndpoint edge = mode == "local" ? EdgeEndpoint{} : openEdge(options);
   const std::unique_ptr<SlamSystem> slam_system =
-      makeSlamSystem(mode, reader->camera(), slam_options);
+      makeSlamSystem(options, mode, reader->camera(), sensor, slam_options, edge);
   SlamSystem& slam = *slam_system;
   SampleStats client_ms, load_ms;
   ProgressLine progress;
@@ -220,9 +264,7 @@ int runPipeline(const RunOptions& options) {
 
 }  // namespace
 
-void addRunCommand(CLI::App& app) {
-  auto options = std::make_shared<RunOptions>();
-  auto* run = app.add_subcommand("run", "Run SLAM on a dataset (client and edge in one command)");
+void addRunOptions(CLI::App* run, const std::shared_ptr<RunOptions>& options) {
   run->add_option("--dataset", options->dataset, "Dataset folder (or video file)")->required();
   run->add_option("--format", options->format, "Dataset format")
       ->check(CLI::IsMember({"auto", "tum", "kitti", "euroc", "7scenes", "images", "video"}));
@@ -230,7 +272,9 @@ void addRunCommand(CLI::App& app) {
       ->check(CLI::IsMember({"auto", "mono", "rgbd", "stereo"}));
   run->add_option("--mode", options->mode, "edge (edgeSLAM), local (ORB-SLAM), offload (Mask-SLAM)")
       ->check(CLI::IsMember({"edge", "local", "offload"}));
-  run->add_option("--link", options->link, "Emulated link profile between client and edge");
+  run->add_option("--link", options->link,
+                  "Emulated link between client and edge: none, wifi5, wifi24, lte, lte-congested")
+      ->check(CLI::IsMember(linkProfileNames()));
   run->add_option("--adapt", options->adapt, "Self-adaptation on|off")
       ->transform(
           CLI::CheckedTransformer(std::map<std::string, bool>{{"on", true}, {"off", false}}));
@@ -262,8 +306,30 @@ void addRunCommand(CLI::App& app) {
   run->add_option("--starving", options->starving,
                   "Tracked ratio below which keyframe rule 1 is waived (tracking starves)")
       ->check(CLI::Range(0.0, 1.0));
+}
+
+void addRunCommand(CLI::App& app) {
+  auto options = std::make_shared<RunOptions>();
+  auto* run = app.add_subcommand("run", "Run SLAM on a dataset (client and edge in one command)");
+  addRunOptions(run, options);
   run->callback([options] { exitCode() = runPipeline(*options); });
 }
+
+void addClientCommand(CLI::App& app) {
+  auto options = std::make_shared<RunOptions>();
+  auto* client = app.add_subcommand(
+      "client", "The mobile client alone, against an edge server (`edgeslam server`)");
+  addRunOptions(client, options);
+  client->add_option("--server", options->server_address, "Edge server HOST:PORT")->required();
+  client->callback([options] {
+    if (options->mode == "local") {
+      throw std::invalid_argument("edgeslam client needs --mode edge or offload");
+    }
+    exitCode() = runPipeline(*options);
+  });
+}
+
+const CommandRegistration kClientCommandRegistration{20, addClientCommand};
 
 const CommandRegistration kRunCommandRegistration{10, addRunCommand};
 

@@ -13,6 +13,7 @@ struct RunOptions {
   std::string sensor = "auto";  // mono|rgbd|stereo; auto = rgbd when the dataset has depth
   std::string mode = "edge";    // edge|local|offload
   std::string link = "none";
+  std::string server_address;  // `client`: the edge server; empty = embedded on loopback
   bool adapt = true;
   bool semantic = false;
   std::size_t max_frames = 0;  // 0 = all

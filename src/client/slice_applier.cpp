@@ -37,6 +37,12 @@ SliceApplyResult applySlice(Map& map, const MapSlice& slice, const PinholeCamera
       ++result.points_upserted;
     }
   }
+  for (const PointPositionRecord& record : slice.point_positions) {
+    if (MapPoint* p = map.mapPoint(record.id)) {
+      map.relocatePoint(p, record.position);
+      ++result.points_moved;
+    }
+  }
   for (KeyFrame* kf : touched) {
     if (kf != nullptr && !kf->isBad()) map.updateConnections(kf);
   }

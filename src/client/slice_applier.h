@@ -12,6 +12,7 @@ namespace edgeslam {
 
 struct SliceApplyResult {
   std::size_t points_upserted = 0;
+  std::size_t points_moved = 0;
   std::size_t points_erased = 0;
   std::size_t keyframes_moved = 0;
   std::size_t keyframes_erased = 0;

@@ -39,7 +39,10 @@ void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
     try {
       keyframe = insertKeyFrameRecord(map_, upload.keyframe, camera_);
       for (const MapPointRecord& point : upload.new_points) {
-        if (map_.mapPoint(point.id) == nullptr) upsertPointRecord(map_, point, upload.keyframe.id);
+        if (map_.mapPoint(point.id) != nullptr) continue;
+        // Normal, descriptor and distance range follow from the observations: the upload need
+        // not carry them.
+        if (MapPoint* p = upsertPointRecord(map_, point, upload.keyframe.id)) map_.refreshPoint(p);
       }
     } catch (...) {
       map_.setChangeRecording(true);

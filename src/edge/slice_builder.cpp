@@ -25,6 +25,10 @@ MapSlice buildSlice(const Map& map, const MapChanges& changes) {
     const MapPoint* p = map.mapPoint(id);
     if (p != nullptr && !p->isBad()) slice.points_upserted.push_back(mapPointRecord(*p));
   }
+  for (MapPointId id : sorted(changes.points_moved)) {
+    const MapPoint* p = map.mapPoint(id);
+    if (p != nullptr && !p->isBad()) slice.point_positions.push_back({id, p->position()});
+  }
   slice.points_erased = sorted(changes.points_erased);
 
   std::vector<KeyFrameId> keyframes = sorted(changes.keyframes_created);

@@ -107,14 +107,29 @@ void Map::replacePoint(MapPoint* old_point, MapPoint* replacement) {
 
 void Map::setPointPosition(MapPoint* point, const Eigen::Vector3d& position) {
   point->position_ = position;
-  record().pointUpdated(point->id());
+  record().pointMoved(point->id());
+}
+
+void Map::relocatePoint(MapPoint* point, const Eigen::Vector3d& position) {
+  point->position_ = position;
+  if (!point->isBad()) point->updateNormalAndDepth();
+  record().pointMoved(point->id());
 }
 
 void Map::refreshPoint(MapPoint* point) {
   if (point->isBad()) return;
+  const cv::Mat before = point->descriptor_.clone();
   point->computeDistinctiveDescriptor();
   point->updateNormalAndDepth();
-  record().pointUpdated(point->id());
+  // Normal and distance range follow from position and observations, which the other side has:
+  // only a new representative descriptor makes this more than a move.
+  const bool same_descriptor = !before.empty() && before.size() == point->descriptor_.size() &&
+                               cv::norm(before, point->descriptor_, cv::NORM_HAMMING) == 0;
+  if (same_descriptor) {
+    record().pointMoved(point->id());
+  } else {
+    record().pointUpdated(point->id());
+  }
 }
 
 void Map::setPointAppearance(MapPoint* point, const Eigen::Vector3d& normal,

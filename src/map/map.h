@@ -40,6 +40,9 @@ class Map {
   // Moves every observation of `old_point` to `replacement` (point fusion) and erases `old_point`.
   void replacePoint(MapPoint* old_point, MapPoint* replacement);
   void setPointPosition(MapPoint* point, const Eigen::Vector3d& position);
+  // Sets the position and recomputes what follows from it (normal, distance range), keeping the
+  // descriptor: a replica applying a move.
+  void relocatePoint(MapPoint* point, const Eigen::Vector3d& position);
   // Sets what refreshPoint would compute, as received from the other side of the wire.
   void setPointAppearance(MapPoint* point, const Eigen::Vector3d& normal, const cv::Mat& descriptor,
                           float min_distance, float max_distance);

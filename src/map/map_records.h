@@ -66,6 +66,12 @@ struct KeyFrameUpload {
   std::uint64_t acknowledged_slice = 0;  // last slice the client applied
 };
 
+// A point that only moved: the receiver recomputes normal and distance range itself.
+struct PointPositionRecord {
+  MapPointId id = kInvalidId;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+};
+
 struct KeyFramePoseRecord {
   KeyFrameId id = kInvalidId;
   SE3d T_cw;
@@ -92,6 +98,7 @@ struct MapSlice {
   bool full_resync = false;               // the client must drop its map and take this one
   std::vector<KeyFrameRecord> keyframes;  // keyframes the client does not have (resync, edge-made)
   std::vector<MapPointRecord> points_upserted;
+  std::vector<PointPositionRecord> point_positions;
   std::vector<MapPointId> points_erased;
   std::vector<KeyFramePoseRecord> keyframe_poses;
   std::vector<KeyFrameId> keyframes_erased;

@@ -48,7 +48,8 @@ TEST(Map, RecordsCreationsAndForgetsPointsBornAndDeadInOneSlice) {
   const MapChanges second = t.map.takeChanges();
   EXPECT_FALSE(second.points_created.contains(fresh->id()));
   EXPECT_FALSE(second.points_erased.contains(fresh->id()));
-  EXPECT_TRUE(second.points_updated.contains(old->id()));
+  EXPECT_TRUE(second.points_moved.contains(old->id()));
+  EXPECT_FALSE(second.points_updated.contains(old->id()));
 
   t.map.erasePoint(old);
   const MapChanges third = t.map.takeChanges();
