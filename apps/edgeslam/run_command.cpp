@@ -2,6 +2,7 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
@@ -19,6 +20,7 @@
 #include "pipeline/grpc_edge_link.h"
 #include "pipeline/local_slam.h"
 #include "pipeline/offload_slam.h"
+#include "place/vocabulary.h"
 #include "progress_line.h"
 #include "run_options.h"
 #include "util/timing_stats.h"
@@ -56,6 +58,32 @@ std::optional<nlohmann::json> ateJson(const Trajectory& gt, const Trajectory& es
                         {"pairs", ate.translation.count},
                         {"scale", ate.alignment.scale()},
                         {"align", toString(align)}};
+}
+
+std::shared_ptr<const Vocabulary> loadVocabulary(const std::string& requested) {
+  if (requested == "none") return nullptr;
+  std::filesystem::path path = requested;
+  if (path.empty()) {
+    if (const char* env = std::getenv("EDGESLAM_VOCAB")) {
+      path = env;
+    } else {
+      std::error_code error;
+      const auto binary = std::filesystem::read_symlink("/proc/self/exe", error);
+      if (!error) path = binary.parent_path() / "vocab" / "orb_k10_l5.vocab";
+    }
+    if (path.empty() || !std::filesystem::exists(path)) {
+      spdlog::warn(
+          "no vocabulary ({}): relocalisation tries recent keyframes only and loops are not "
+          "closed; `make vocab` trains one, --vocab FILE names one",
+          path.empty() ? "none found" : path.string() + " missing");
+      return nullptr;
+    }
+  }
+  Stopwatch timer;
+  auto vocabulary = std::make_shared<const Vocabulary>(Vocabulary::load(path));
+  spdlog::info("vocabulary {}: {} words, loaded in {:.0f} ms", path.string(),
+               vocabulary->wordCount(), timer.elapsedMs());
+  return vocabulary;
 }
 
 Sensor toSensor(const std::string& name) {
@@ -144,6 +172,7 @@ int runPipeline(const RunOptions& options) {
   if (options.beta) kf.beta = *options.beta;
   if (options.starving) kf.starving_ratio = *options.starving;
   slam_options.orb.validate();
+  slam_options.tracker.vocabulary = loadVocabulary(options.vocabulary);
   spdlog::info("{} ORB features, {} levels; keyframes fmin {} fmax {} alpha {} beta {}",
                slam_options.orb.num_features, slam_options.orb.num_levels, kf.fmin, kf.fmax,
                kf.alpha, kf.beta);
@@ -290,6 +319,9 @@ void addRunOptions(CLI::App* run, const std::shared_ptr<RunOptions>& options) {
   run->add_option("--viewer", options->viewer_port, "Serve the web viewer on this port");
   run->add_option("--camera", options->camera_file, "Camera YAML overriding the dataset's camera")
       ->check(CLI::ExistingFile);
+  run->add_option("--vocab", options->vocabulary,
+                  "Vocabulary file for relocalisation and loops (default: vocab/ next to the "
+                  "binary or $EDGESLAM_VOCAB; none = without)");
   run->add_option("--features", options->features,
                   "ORB features per frame (default 1000, 2000 above 640x480)")
       ->check(CLI::Range(100, 20000));

@@ -22,6 +22,9 @@ struct RunOptions {
   std::filesystem::path out_dir;
   int viewer_port = 0;
   std::optional<std::filesystem::path> camera_file;
+  // Bag-of-words vocabulary for relocalisation and loop closing; "" = the default file next to the
+  // binary (vocab/orb_k10_l5.vocab) when present, "none" = without.
+  std::string vocabulary;
   // Tuning; unset values keep the defaults (Table I row 1 for local tracking).
   std::optional<int> features;
   std::optional<int> levels;

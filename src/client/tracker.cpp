@@ -28,7 +28,13 @@ Tracker::Tracker(Map& map, const PinholeCamera& camera, TrackerOptions options, 
       camera_(camera),
       options_(std::move(options)),
       sink_(sink),
-      mono_init_(camera, options_.monocular_init) {}
+      mono_init_(camera, options_.monocular_init) {
+  if (options_.vocabulary) places_ = std::make_unique<KeyFramePlaces>(options_.vocabulary);
+}
+
+void Tracker::remember(KeyFrame* keyframe) {
+  if (places_ && keyframe != nullptr) places_->add(*keyframe);
+}
 
 TrackResult Tracker::track(std::size_t frame_index, double timestamp,
                            std::shared_ptr<const FrameFeatures> features) {
@@ -149,6 +155,8 @@ bool Tracker::initialize(Frame& frame) {
     kf0 = map_.originKeyFrame();
     spdlog::info("monocular map initialised at frame {} with {} points (reference frame {})",
                  frame.index, map_.pointCount(), kf0->frameIndex());
+    remember(kf0);
+    remember(kf);
     reference_keyframe_ = kf;
     last_keyframe_frame_ = frame.index;
     frame.reference_keyframe = kf;
@@ -195,6 +203,7 @@ bool Tracker::initializeRgbd(Frame& frame) {
     }
     spdlog::info("RGB-D map initialised at frame {} with {} points", frame.index,
                  map_.pointCount());
+    remember(kf);
   }
   reference_keyframe_ = kf;
   last_keyframe_frame_ = frame.index;
@@ -251,25 +260,46 @@ bool Tracker::trackReferenceKeyFrame(Frame& frame) {
   return discardOutliers(frame) >= options_.min_inliers_motion;
 }
 
-bool Tracker::relocalize(Frame& frame) {
-  // Without a place-recognition database yet, try the most recent keyframes and the last
-  // reference's neighbourhood.
+std::vector<KeyFrame*> Tracker::relocalizationCandidates(const Frame& frame) {
   std::vector<KeyFrame*> candidates;
-  const std::vector<KeyFrame*> all = map_.keyFrames();
-  for (auto it = all.rbegin(); it != all.rend() && candidates.size() < 15; ++it) {
-    candidates.push_back(*it);
-  }
-  if (reference_keyframe_ != nullptr && !reference_keyframe_->isBad()) {
-    for (KeyFrame* kf : reference_keyframe_->bestCovisibles(10)) {
-      if (std::find(candidates.begin(), candidates.end(), kf) == candidates.end()) {
-        candidates.push_back(kf);
-      }
+  const auto add = [&](KeyFrame* kf) {
+    if (kf != nullptr && !kf->isBad() &&
+        std::find(candidates.begin(), candidates.end(), kf) == candidates.end()) {
+      candidates.push_back(kf);
     }
+  };
+  if (places_) {
+    for (KeyFrameId id : places_->similar(*frame.features, options_.relocalization_candidates)) {
+      add(map_.keyFrame(id));
+    }
+    return candidates;
   }
-  for (KeyFrame* kf : candidates) {
-    std::fill(frame.points.begin(), frame.points.end(), nullptr);
-    std::fill(frame.outliers.begin(), frame.outliers.end(), false);
-    if (matchKeyFrameByDescriptor(*kf, frame, 0.75f) < 15) continue;
+  // Without place recognition: the most recent keyframes and the last reference's neighbours.
+  const std::vector<KeyFrame*> all = map_.keyFrames();
+  for (auto it = all.rbegin(); it != all.rend() && candidates.size() < 15; ++it) add(*it);
+  if (reference_keyframe_ != nullptr && !reference_keyframe_->isBad()) {
+    for (KeyFrame* kf : reference_keyframe_->bestCovisibles(10)) add(kf);
+  }
+  return candidates;
+}
+
+int Tracker::matchForRelocalization(KeyFrame& candidate, Frame& frame) {
+  std::fill(frame.points.begin(), frame.points.end(), nullptr);
+  std::fill(frame.outliers.begin(), frame.outliers.end(), false);
+  if (!places_) return matchKeyFrameByDescriptor(candidate, frame, 0.75f);
+  int matched = 0;
+  for (const cv::DMatch& m : places_->match(candidate)) {
+    MapPoint* p = candidate.point(static_cast<std::size_t>(m.trainIdx));
+    if (p == nullptr || p->isBad()) continue;
+    frame.points[static_cast<std::size_t>(m.queryIdx)] = p;
+    ++matched;
+  }
+  return matched;
+}
+
+bool Tracker::relocalize(Frame& frame) {
+  for (KeyFrame* kf : relocalizationCandidates(frame)) {
+    if (matchForRelocalization(*kf, frame) < 15) continue;
     std::vector<Eigen::Vector2d> pixels;
     std::vector<Eigen::Vector3d> points;
     std::vector<std::size_t> index;
@@ -449,6 +479,7 @@ KeyFrame* Tracker::createKeyFrame(Frame& frame) {
   }
   for (MapPoint* p : kf->goodPoints()) map_.refreshPoint(p);
   map_.updateConnections(kf);
+  remember(kf);
   reference_keyframe_ = kf;
   last_keyframe_frame_ = frame.index;
   frame.reference_keyframe = kf;
@@ -472,6 +503,7 @@ void Tracker::record(const Frame& frame, bool tracked) {
 void Tracker::resetMap() {
   std::lock_guard lock(map_.updateMutex());
   map_.clear();
+  if (places_) places_->clear();
   for (FrameRecord& r : records_) {
     r.tracked = false;
     r.reference = nullptr;

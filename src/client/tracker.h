@@ -9,6 +9,7 @@
 #include <optional>
 #include <vector>
 
+#include "client/keyframe_places.h"
 #include "client/keyframe_policy.h"
 #include "client/monocular_initializer.h"
 #include "client/tracking_types.h"
@@ -29,6 +30,10 @@ struct TrackerOptions {
   int min_inliers_local_map = 30;
   int min_inliers_local_map_after_relocalization = 50;
   std::size_t max_local_keyframes = 80;
+  // With a vocabulary, relocalisation looks up similar keyframes in a bag-of-words database;
+  // without, it tries the most recent keyframes only.
+  std::shared_ptr<const Vocabulary> vocabulary;
+  std::size_t relocalization_candidates = 10;
 };
 
 class Tracker {
@@ -62,6 +67,9 @@ class Tracker {
   bool trackWithMotionModel(Frame& frame);
   bool trackReferenceKeyFrame(Frame& frame);
   bool relocalize(Frame& frame);
+  std::vector<KeyFrame*> relocalizationCandidates(const Frame& frame);
+  int matchForRelocalization(KeyFrame& candidate, Frame& frame);
+  void remember(KeyFrame* keyframe);
   int trackLocalMap(Frame& frame);
   void updateLocalMap(const Frame& frame);
   void addPointsFromLastFrameDepth(Frame& last);
@@ -76,6 +84,7 @@ class Tracker {
   TrackerOptions options_;
   KeyFrameSink* sink_;
   MonocularInitializer mono_init_;
+  std::unique_ptr<KeyFramePlaces> places_;
 
   TrackingState state_ = TrackingState::kNotInitialized;
   std::optional<Frame> last_frame_;

@@ -3,9 +3,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <opencv2/calib3d.hpp>
+#include <opencv2/features2d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <string>
 
 #include "features/descriptor_matching.h"
 #include "features/feature_grid.h"
@@ -137,6 +140,50 @@ TEST(OrbRealFrames, NearbyFramesMatchConsistentlyWithEpipolarGeometry) {
   ASSERT_FALSE(F.empty());
   const double ratio = cv::countNonZero(inliers) / static_cast<double>(matches.size());
   EXPECT_GT(ratio, 0.8) << matches.size() << " matches";
+}
+
+std::string sevenScenesFrame(int index) {
+  char name[64];
+  std::snprintf(name, sizeof name, "frame-%06d.color.jpg", index);
+  return std::string("datasets/7scenes-redkitchen-1000/") + name;
+}
+
+// Mutual nearest-neighbour descriptor matches (no distance or ratio threshold) that a fundamental
+// matrix RANSAC keeps: how many correct correspondences the descriptors find by themselves.
+int epipolarMutualMatches(const OrbFeatures& a, const OrbFeatures& b) {
+  cv::BFMatcher matcher(cv::NORM_HAMMING, /*crossCheck=*/true);
+  std::vector<cv::DMatch> matches;
+  matcher.match(a.descriptors, b.descriptors, matches);
+  std::vector<cv::Point2f> pa, pb;
+  for (const cv::DMatch& m : matches) {
+    pa.push_back(a.keypoints[m.queryIdx].pt);
+    pb.push_back(b.keypoints[m.trainIdx].pt);
+  }
+  cv::Mat inliers;
+  cv::findFundamentalMat(pa, pb, cv::FM_RANSAC, 2.0, 0.999, inliers);
+  return inliers.empty() ? 0 : cv::countNonZero(inliers);
+}
+
+// Guards the extractor's speed work (smaller blur, merged FAST retries, ...) against quality loss.
+// The reference, 1157, is what the extractor of November 2026 (7x7 blur, per-cell retries) scored
+// on these pairs; OpenCV's RANSAC is seeded, so the figure only moves when the features do.
+TEST(OrbRealFrames, DescriptorsKeepTheirEpipolarMatchCountOnNeighbouringFrames) {
+  EDGESLAM_REQUIRE_SHARED(sevenScenesFrame(605));
+  OrbExtractor extractor;
+  int total = 0;
+  for (const auto& [first, second] : {std::pair{0, 5}, std::pair{300, 303}, std::pair{600, 605}}) {
+    const cv::Mat image = readGrey(sevenScenesFrame(first).c_str());
+    const OrbFeatures a = extractor.extract(image);
+    const OrbFeatures b = extractor.extract(readGrey(sevenScenesFrame(second).c_str()));
+    const int good = epipolarMutualMatches(a, b);
+    EXPECT_GT(good, 300) << first << "-" << second;
+    total += good;
+    // Spread: nearly every cell of an 8 x 6 grid holds keypoints.
+    const auto counts = cellCounts(a.keypoints, image.size());
+    EXPECT_GE(std::count_if(counts.begin(), counts.end(), [](int c) { return c > 0; }), 44)
+        << "frame " << first;
+  }
+  EXPECT_GE(total, 0.97 * 1157) << "RANSAC-consistent mutual matches over the three pairs";
 }
 
 TEST(OrbRealFrames, UndistortedKeypointsAndGridOnADistortedCamera) {

@@ -1,0 +1,63 @@
+#include "client/keyframe_places.h"
+
+#include <stdexcept>
+
+#include "place/bow_matching.h"
+
+namespace edgeslam {
+namespace {
+
+// The direct index files features two levels above the leaves: ~100 features per node pair.
+constexpr int kDirectIndexLevelsUp = 2;
+
+}  // namespace
+
+KeyFramePlaces::KeyFramePlaces(std::shared_ptr<const Vocabulary> vocabulary)
+    : vocabulary_(std::move(vocabulary)) {
+  if (!vocabulary_ || vocabulary_->empty()) {
+    throw std::invalid_argument("place recognition needs a non-empty vocabulary");
+  }
+}
+
+KeyFramePlaces::Indexed KeyFramePlaces::index(const FrameFeatures& features) const {
+  Indexed out;
+  vocabulary_->transform(features.descriptors, kDirectIndexLevelsUp, out.bow, out.direct);
+  return out;
+}
+
+void KeyFramePlaces::add(const KeyFrame& keyframe) {
+  Indexed indexed = index(keyframe.features());
+  database_.add(keyframe.id(), indexed.bow);
+  direct_index_[keyframe.id()] = std::move(indexed.direct);
+}
+
+void KeyFramePlaces::clear() {
+  database_.clear();
+  direct_index_.clear();
+  query_features_ = nullptr;
+}
+
+std::vector<KeyFrameId> KeyFramePlaces::similar(const FrameFeatures& frame, std::size_t max_results,
+                                                double relative_min) {
+  query_ = index(frame);
+  query_features_ = &frame;
+  const std::vector<PlaceQueryResult> results = database_.query(query_.bow, max_results);
+  std::vector<KeyFrameId> out;
+  if (results.empty()) return out;
+  const double best = results.front().score;
+  for (const PlaceQueryResult& r : results) {
+    if (r.score >= relative_min * best) out.push_back(r.id);
+  }
+  return out;
+}
+
+std::vector<cv::DMatch> KeyFramePlaces::match(const KeyFrame& keyframe) const {
+  const auto it = direct_index_.find(keyframe.id());
+  if (it == direct_index_.end() || query_features_ == nullptr) return {};
+  const FrameFeatures& frame = *query_features_;
+  const FrameFeatures& kf = keyframe.features();
+  return matchByBow(query_.direct, frame.keypoints, frame.descriptors, it->second, kf.keypoints,
+                    kf.descriptors);
+}
+
+}  // namespace edgeslam

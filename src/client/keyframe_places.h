@@ -1,0 +1,47 @@
+#pragma once
+// The client's place recognition: every keyframe it makes goes into a bag-of-words database, so
+// that a lost frame can find the keyframes that look like it (relocalisation), and be matched to
+// them word by word.
+#include <memory>
+#include <unordered_map>
+#include <vector>
+
+#include "map/frame.h"
+#include "map/keyframe.h"
+#include "place/feature_vector.h"
+#include "place/keyframe_database.h"
+#include "place/vocabulary.h"
+
+namespace edgeslam {
+
+class KeyFramePlaces {
+ public:
+  explicit KeyFramePlaces(std::shared_ptr<const Vocabulary> vocabulary);
+
+  void add(const KeyFrame& keyframe);
+  void clear();
+
+  // Indexes a frame to look up, and returns the ids of the stored keyframes most similar to it,
+  // best first, at most `max_results`, none scoring under `relative_min` times the best.
+  std::vector<KeyFrameId> similar(const FrameFeatures& frame, std::size_t max_results,
+                                  double relative_min = 0.6);
+  // Matches of the last frame given to similar() (queryIdx) to a keyframe's keypoints (trainIdx)
+  // through the direct index, rotation-checked.
+  std::vector<cv::DMatch> match(const KeyFrame& keyframe) const;
+
+ private:
+  struct Indexed {
+    BowVector bow;
+    FeatureVector direct;
+  };
+  Indexed index(const FrameFeatures& features) const;
+
+  std::shared_ptr<const Vocabulary> vocabulary_;
+  KeyFrameDatabase database_;
+  std::unordered_map<KeyFrameId, FeatureVector> direct_index_;
+  // The frame being looked up, indexed once for all its candidates.
+  const FrameFeatures* query_features_ = nullptr;
+  Indexed query_;
+};
+
+}  // namespace edgeslam
