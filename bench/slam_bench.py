@@ -1,9 +1,12 @@
 #!/usr/bin/env python3
-"""SLAM accuracy/speed benchmark: the issue's reference rows, each run N times, pinned to one core.
+"""SLAM accuracy/speed benchmark: the issue's reference rows, each run N times, in each run mode.
 
+local: the whole run pinned to one core. edge / offload: an `edgeslam server` process pinned to core 1
+and the `edgeslam client` pinned to core 0, over loopback gRPC (as the edge issue asks).
 Prints a markdown table (median of the runs and [min-max] spread) and writes it to docs/benchmarks.md
 (between the SLAM markers) unless --no-docs. Usage:
-  bench/slam_bench.py [--build build] [--runs 3] [--shared ../shared] [--rows mono,rgbd,kitti] [--mode local]
+  bench/slam_bench.py [--build build] [--runs 3] [--shared ../shared] [--rows mono,rgbd,kitti]
+                      [--modes local,edge,offload]
 """
 import argparse
 import json
@@ -13,6 +16,7 @@ import statistics
 import subprocess
 import sys
 import tempfile
+import time
 
 ROWS = {
     "mono": ("7-Scenes redkitchen 1000", "datasets/7scenes-redkitchen-1000", "mono",
@@ -24,12 +28,29 @@ ROWS = {
 }
 
 
-def run_once(binary, dataset, sensor, mode, cpu):
+def pinned(cmd, cpu):
+    return cmd if cpu is None else ["taskset", "-c", str(cpu)] + cmd
+
+
+def run_once(binary, dataset, sensor, mode, cpu, port):
     with tempfile.TemporaryDirectory() as out:
-        cmd = [binary, "run", "--dataset", dataset, "--sensor", sensor, "--mode", mode, "--out", out]
-        if cpu is not None:
-            cmd = ["taskset", "-c", str(cpu)] + cmd
-        subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        common = ["--dataset", dataset, "--sensor", sensor, "--mode", mode, "--out", out]
+        server = None
+        if mode == "local":
+            cmd = pinned([binary, "run"] + common, cpu)
+        else:
+            server = subprocess.Popen(
+                pinned([binary, "server", "--listen", f"127.0.0.1:{port}", "--status-every", "0"],
+                       None if cpu is None else cpu + 1),
+                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            time.sleep(0.5)
+            cmd = pinned([binary, "client", "--server", f"127.0.0.1:{port}"] + common, cpu)
+        try:
+            subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        finally:
+            if server is not None:
+                server.terminate()
+                server.wait(timeout=10)
         with open(os.path.join(out, "metrics.json")) as f:
             return json.load(f)
 
@@ -46,7 +67,8 @@ def main():
     parser.add_argument("--shared", default=os.environ.get("EDGESLAM_SHARED",
                                                            os.path.join(root, "..", "shared")))
     parser.add_argument("--rows", default="mono,rgbd,kitti")
-    parser.add_argument("--mode", default="local")
+    parser.add_argument("--modes", default="local", help="comma list of local, edge, offload")
+    parser.add_argument("--port", type=int, default=50151)
     parser.add_argument("--cpu", default="0", help="core to pin to; 'none' for no pinning")
     parser.add_argument("--no-docs", action="store_true")
     args = parser.parse_args()
@@ -54,9 +76,11 @@ def main():
     cpu = None if args.cpu == "none" else int(args.cpu)
 
     lines = ["| sequence | sensor | mode | tracked | frames before init | ATE final RMSE, cm (median [min-max]) "
-             "| ATE at frame time, cm | client ms median / p90 / p99 | ORB-SLAM2 ATE | ORB-SLAM2 ms median / p90 |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
-    for key in args.rows.split(","):
+             "| ATE at frame time, cm | client ms median / p90 / p99 | e2e ms median / p99 "
+             "| uplink KB per keyframe (per frame offload) | slice latency ms median | ORB-SLAM2 ATE "
+             "| ORB-SLAM2 ms median / p90 |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for key, mode in [(k, m) for k in args.rows.split(",") for m in args.modes.split(",")]:
         name, rel, sensor, ref_ate, ref_ms = ROWS[key]
         dataset = os.path.join(args.shared, rel)
         if not os.path.isdir(dataset):
@@ -64,8 +88,8 @@ def main():
             continue
         runs = []
         for i in range(args.runs):
-            print(f"{key}: run {i + 1}/{args.runs}", file=sys.stderr, flush=True)
-            runs.append(run_once(binary, dataset, sensor, args.mode, cpu))
+            print(f"{key} {mode}: run {i + 1}/{args.runs}", file=sys.stderr, flush=True)
+            runs.append(run_once(binary, dataset, sensor, mode, cpu, args.port))
         ate = [100 * r["ate_final"]["rmse_m"] for r in runs if "ate_final" in r]
         ate_t = [100 * r["ate"]["rmse_m"] for r in runs if "ate" in r]
         tracked = [r["tracked"] for r in runs]
@@ -73,13 +97,23 @@ def main():
         med = [r["client_ms"]["median"] for r in runs]
         p90 = [r["client_ms"]["p90"] for r in runs]
         p99 = [r["client_ms"]["p99"] for r in runs]
+        e2e = [r["e2e_ms"]["median"] for r in runs]
+        e2e99 = [r["e2e_ms"]["p99"] for r in runs]
+        if mode == "offload":
+            up = [r["uplink_bytes"] / 1000 / max(1, r["frames"]) for r in runs]
+        else:
+            up = [r["uplink_bytes"] / 1000 / max(1, r.get("keyframes_uploaded", 0)) for r in runs]
+        slice_ms = [r["slice_latency_ms"]["median"] for r in runs]
         f2 = lambda v: f"{v:.2f}"
         f1 = lambda v: f"{v:.1f}"
         lines.append(
-            f"| {name} | {sensor} | {args.mode} | {statistics.median(tracked):.0f}/{runs[0]['frames']} "
+            f"| {name} | {sensor} | {mode} | {statistics.median(tracked):.0f}/{runs[0]['frames']} "
             f"| {statistics.median(init):.0f} | {spread(ate, f2) if ate else '-'} "
             f"| {spread(ate_t, f2) if ate_t else '-'} "
             f"| {f1(statistics.median(med))} / {f1(statistics.median(p90))} / {f1(statistics.median(p99))} "
+            f"| {f1(statistics.median(e2e))} / {f1(statistics.median(e2e99))} "
+            f"| {f1(statistics.median(up)) if mode != 'local' else '-'} "
+            f"| {f1(statistics.median(slice_ms)) if mode == 'edge' else '-'} "
             f"| {ref_ate} | {ref_ms} |")
     table = "\n".join(lines)
     print(table)

@@ -65,6 +65,21 @@ LocalMapperStats LocalMapper::stats() const {
   return stats_;
 }
 
+void LocalMapper::pause() {
+  std::unique_lock lock(queue_mutex_);
+  paused_ = true;
+  abort_ba_ = true;
+  idle_cv_.wait(lock, [this] { return !busy_; });
+}
+
+void LocalMapper::resume() {
+  {
+    std::lock_guard lock(queue_mutex_);
+    paused_ = false;
+  }
+  queue_cv_.notify_all();
+}
+
 void LocalMapper::waitUntilIdle() {
   if (!thread_.joinable()) {
     processAll();
@@ -95,7 +110,7 @@ void LocalMapper::run() {
       std::unique_lock lock(queue_mutex_);
       busy_ = false;
       idle_cv_.notify_all();
-      queue_cv_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
+      queue_cv_.wait(lock, [this] { return stopping_ || (!paused_ && !queue_.empty()); });
       if (stopping_) return;
       kf = queue_.front();
       queue_.pop_front();
@@ -121,6 +136,7 @@ void LocalMapper::mapKeyFrame(KeyFrame* keyframe) {
     std::lock_guard lock(map_.updateMutex());
     if (keyframe->isBad()) return;
     linkKeyFrame(keyframe);
+    if (options_.observe_recent_points) observeRecentPoints(keyframe);
     cullRecentPoints(keyframe);
   }
   createNewPoints(keyframe);
@@ -148,6 +164,17 @@ void LocalMapper::linkKeyFrame(KeyFrame* keyframe) {
     map_.refreshPoint(p);
   }
   map_.updateConnections(keyframe);
+}
+
+void LocalMapper::observeRecentPoints(KeyFrame* keyframe) {
+  std::vector<MapPoint*> candidates;
+  for (MapPoint* p : recent_points_) {
+    if (!p->isBad() && !p->observations().contains(keyframe->id())) candidates.push_back(p);
+  }
+  if (candidates.empty()) return;
+  const int observed = fuse(map_, keyframe, candidates, camera_);
+  if (observed > 0) map_.updateConnections(keyframe);
+  spdlog::debug("keyframe {}: {} recent points observed after the fact", keyframe->id(), observed);
 }
 
 void LocalMapper::cullRecentPoints(KeyFrame* keyframe) {

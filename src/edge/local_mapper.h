@@ -30,6 +30,10 @@ struct LocalMapperOptions {
   std::size_t max_queue = 3;     // tracking is asked to wait beyond this backlog
   double redundant_ratio = 0.9;  // a keyframe whose points are 90 % seen by 3+ others is culled
   bool run_local_ba = true;
+  // Across a network the client makes its next keyframe before it has the points the edge just
+  // triangulated, so the keyframe cannot observe them: search it for the recent points before
+  // culling those as unobserved.
+  bool observe_recent_points = false;
   bool cull_keyframes = true;
 };
 
@@ -59,6 +63,11 @@ class LocalMapper : public KeyFrameSink {
 
   LocalMapperStats stats() const;
 
+  // Loop closing: stops mapping between keyframes (a running local BA is aborted) until resume().
+  // Returns once the mapping thread is idle; without a thread there is nothing to wait for.
+  void pause();
+  void resume();
+
   // Called on the mapping thread after each keyframe is mapped (set before start()).
   void setKeyFrameMappedCallback(std::function<void(KeyFrame*)> callback) {
     on_mapped_ = std::move(callback);
@@ -69,6 +78,7 @@ class LocalMapper : public KeyFrameSink {
   void processKeyFrame(KeyFrame* keyframe);
   void mapKeyFrame(KeyFrame* keyframe);
   void linkKeyFrame(KeyFrame* keyframe);
+  void observeRecentPoints(KeyFrame* keyframe);
   void cullRecentPoints(KeyFrame* keyframe);
   void createNewPoints(KeyFrame* keyframe);
   void fuseWithNeighbours(KeyFrame* keyframe);
@@ -85,6 +95,7 @@ class LocalMapper : public KeyFrameSink {
   std::deque<KeyFrame*> queue_;
   bool busy_ = false;
   bool stopping_ = false;
+  bool paused_ = false;
   std::thread thread_;
 
   std::atomic<bool> abort_ba_{false};

@@ -42,8 +42,10 @@ SlamSessionBackend::~SlamSessionBackend() {
 
 void SlamSessionBackend::onKeyFrame(KeyFrameUpload upload) {
   if (!mapping_) {
+    EdgeMapSessionOptions mapping = options_.mapping;
+    mapping.mapper.observe_recent_points = true;
     mapping_ = std::make_unique<EdgeMapSession>(
-        config_.camera, config_.sensor, options_.mapping, [this](MapSlice slice) {
+        config_.camera, config_.sensor, mapping, [this](MapSlice slice) {
           try {
             sink_.push(std::move(slice));
           } catch (const std::exception& e) {
