@@ -142,7 +142,16 @@ std::unique_ptr<SlamSystem> makeSlamSystem(const RunOptions& options, const std:
                                          std::make_unique<EdgeClient>(edge.address, config));
   }
   auto link = std::make_unique<GrpcEdgeLink>(edge.address, config);
-  return std::make_unique<EdgeSlam>(camera, slam_options, std::move(link));
+  AdaptationLoopOptions adaptation;
+  adaptation.adapt = options.adapt;
+  adaptation.controller.initial_row = 0;  // the run starts with Table I row 1
+  if (options.adapt &&
+      (options.fmin || options.fmax || options.alpha || options.beta || options.levels)) {
+    spdlog::warn(
+        "--adapt on retunes fmin/fmax/alpha/beta/levels as the link changes; "
+        "--adapt off keeps the values given");
+  }
+  return std::make_unique<EdgeSlam>(camera, slam_options, std::move(link), adaptation);
 }
 
 int runPipeline(const RunOptions& options) {
@@ -251,6 +260,29 @@ int runPipeline(const RunOptions& options) {
                             {"dataset", info.path.string()},
                             {"wall_s", seconds},
                             {"load_ms", toJson(load_ms.summary())}};
+  if (const auto* edge_slam = dynamic_cast<const EdgeSlam*>(&slam);
+      edge_slam != nullptr && edge_slam->adaptation() != nullptr) {
+    const AdaptationLoop& loop = *edge_slam->adaptation();
+    const AdaptationLoopCounters c = loop.counters();
+    const NetworkEstimates n = loop.estimates();
+    const auto optional_json = [](const std::optional<double>& v) {
+      return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
+    };
+    metrics["adapt"] = {{"enabled", loop.adapting()},
+                        {"switches", c.switches},
+                        {"frames_per_config", c.frames_per_config},
+                        {"probe_bytes", c.probe_bytes},
+                        {"failed_probes", c.failed_probes},
+                        {"latency_ms", optional_json(n.latency_ms)},
+                        {"bandwidth_mbps", optional_json(n.bandwidth_mbps)},
+                        {"network_time_ms", optional_json(n.network_time_ms)},
+                        {"message_bytes", n.message_bytes}};
+    // Probes share the channel: keep them out of the per-keyframe figure.
+    metrics["bytes_per_keyframe"] =
+        (counters.uplink_bytes -
+         std::min<std::uint64_t>(counters.uplink_bytes, c.probe_uplink_bytes)) /
+        keyframes_uploaded;
+  }
   if (ate) metrics["ate"] = *ate;
   if (ate_final) metrics["ate_final"] = *ate_final;
 

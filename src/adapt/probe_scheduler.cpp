@@ -24,7 +24,11 @@ std::size_t estimatedProbeWireBytes(std::size_t payload_bytes, std::size_t reply
 ProbeScheduler::ProbeScheduler(ProbeSchedule schedule) : schedule_(schedule) {}
 
 ProbeKind ProbeScheduler::next(double now_s) {
-  if (!next_small_s_ || now_s >= *next_small_s_) {
+  const bool small_due = !next_small_s_ || now_s >= *next_small_s_;
+  const bool sized_due = next_sized_s_ && now_s >= *next_sized_s_;
+  // When both are due, the one due first goes first: with probes slower than the small interval
+  // (a stalled link) the small probe is always due again and would starve the sized one.
+  if (small_due && !(sized_due && *next_sized_s_ < *next_small_s_)) {
     // Keep the grid (probes stay `small_interval_s` apart on average); after a long pause, restart
     // it from now instead of firing a burst of overdue probes.
     double next = next_small_s_ ? *next_small_s_ + schedule_.small_interval_s : now_s;
@@ -33,7 +37,7 @@ ProbeKind ProbeScheduler::next(double now_s) {
     if (!next_sized_s_) next_sized_s_ = now_s;
     return ProbeKind::kSmall;
   }
-  if (now_s >= *next_sized_s_) {
+  if (sized_due) {
     double next = *next_sized_s_ + schedule_.sized_interval_s;
     if (next <= now_s) next = now_s + schedule_.sized_interval_s;
     next_sized_s_ = next;

@@ -418,7 +418,8 @@ std::size_t EdgeClient::pendingUploads() const {
   return impl_->queue.size() + (impl_->in_flight ? 1 : 0);
 }
 
-std::optional<ProbeResult> EdgeClient::probe(std::size_t payload_bytes, std::size_t reply_bytes) {
+std::optional<ProbeResult> EdgeClient::probe(std::size_t payload_bytes, std::size_t reply_bytes,
+                                             std::optional<std::chrono::milliseconds> timeout) {
   v1::ProbeRequest request;
   *request.mutable_header() = impl_->header();
   std::string* payload = request.mutable_payload();
@@ -431,7 +432,7 @@ std::optional<ProbeResult> EdgeClient::probe(std::size_t payload_bytes, std::siz
   request.set_reply_bytes(reply_bytes);
   v1::ProbeReply reply;
   grpc::ClientContext context;
-  context.set_deadline(deadlineIn(impl_->options.rpc_timeout));
+  context.set_deadline(deadlineIn(timeout.value_or(impl_->options.rpc_timeout)));
   const auto start = Clock::now();
   const grpc::Status status = impl_->stub->Probe(&context, request, &reply);
   const auto end = Clock::now();

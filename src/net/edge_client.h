@@ -91,8 +91,9 @@ class EdgeClient {
   std::size_t pendingUploads() const;
 
   // Round trip of `payload_bytes` up and `reply_bytes` down; nullopt when the server does not
-  // answer within the RPC timeout.
-  std::optional<ProbeResult> probe(std::size_t payload_bytes, std::size_t reply_bytes);
+  // answer within `timeout` (default: the RPC timeout).
+  std::optional<ProbeResult> probe(std::size_t payload_bytes, std::size_t reply_bytes,
+                                   std::optional<std::chrono::milliseconds> timeout = std::nullopt);
 
   // Offload mode: sends a whole frame and waits for its pose. nullopt when the server is
   // unreachable; throws EdgeClientError when the server rejects the frame.

@@ -9,6 +9,8 @@
 
 namespace edgeslam {
 
+class EdgeClient;
+
 struct EdgeLinkCounters {
   std::uint64_t uplink_bytes = 0;
   std::uint64_t downlink_bytes = 0;
@@ -26,6 +28,8 @@ class EdgeLink : public KeyFrameUplink {
   virtual void setSliceHandler(SliceHandler handler) = 0;
   virtual EdgeLinkCounters counters() const = 0;
   virtual void close() = 0;
+  // The gRPC client under this link, for probing; nullptr when there is no network.
+  virtual EdgeClient* edgeClient() { return nullptr; }
 };
 
 }  // namespace edgeslam

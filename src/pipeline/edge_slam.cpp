@@ -2,21 +2,61 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <cmath>
 #include <thread>
 
 #include "client/slice_applier.h"
 
 namespace edgeslam {
 
-EdgeSlam::EdgeSlam(const PinholeCamera& camera, SlamOptions options, std::unique_ptr<EdgeLink> link)
+EdgeSlam::EdgeSlam(const PinholeCamera& camera, SlamOptions options, std::unique_ptr<EdgeLink> link,
+                   std::optional<AdaptationLoopOptions> adaptation)
     : TrackingSlam(camera, std::move(options), link->idOrigin()), link_(std::move(link)) {
   sink_ = std::make_unique<EdgeKeyFrameSink>(map_, *link_);
   link_->setSliceHandler([this](MapSlice slice) { onSlice(std::move(slice)); });
   startTracking(sink_.get());
+  if (adaptation && link_->edgeClient() != nullptr) {
+    adaptation_ = std::make_unique<AdaptationLoop>(*link_->edgeClient(), *adaptation);
+    adaptation_->start();
+  }
 }
 
 EdgeSlam::~EdgeSlam() {
+  if (adaptation_) adaptation_->stop();  // it probes through the link's client
   link_->close();
+}
+
+void EdgeSlam::afterFrame() {
+  if (!adaptation_) return;
+  adaptation_->onFrame();  // counted under the configuration this frame ran with
+  const std::uint64_t version = adaptation_->version();
+  if (version != applied_config_version_) {
+    applied_config_version_ = version;
+    applyConfiguration(adaptation_->current());
+  }
+  const std::uint64_t uploads = sink_->uploadsSent();
+  if (uploads != uploads_seen_ && uploads > 0) {
+    uploads_seen_ = uploads;
+    const EdgeLinkCounters link = link_->counters();
+    const double probes = static_cast<double>(adaptation_->counters().probe_uplink_bytes);
+    adaptation_->setMessageBytes((static_cast<double>(link.uplink_bytes) - probes) /
+                                 static_cast<double>(uploads));
+  }
+}
+
+void EdgeSlam::applyConfiguration(const KeyframeConfig& config) {
+  // Table I counts frames of a 30 fps camera (as defaultSlamOptions does).
+  const double fps = camera_.intrinsics().fps;
+  const double rate = fps > 0 ? std::min(1.0, fps / 30.0) : 1.0;
+  KeyFrameParameters& kf = tracker_->keyframeParameters();
+  kf.fmin = rate < 0.5 ? 0 : static_cast<int>(std::lround(config.fmin * rate));
+  kf.fmax = std::max(1, static_cast<int>(std::lround(config.fmax * rate)));
+  kf.alpha = config.alpha;
+  kf.beta = config.beta;
+  extractor_.setNumLevels(config.pyramid_levels);
+  spdlog::info("adaptation: keyframes fmin {} fmax {} alpha {} beta {}, {} pyramid levels", kf.fmin,
+               kf.fmax, kf.alpha, kf.beta, config.pyramid_levels);
 }
 
 void EdgeSlam::onSlice(MapSlice slice) {
@@ -36,6 +76,7 @@ void EdgeSlam::onSlice(MapSlice slice) {
 }
 
 void EdgeSlam::finish() {
+  if (adaptation_) adaptation_->stop();
   Stopwatch waited;
   while (!sink_->allAnswered()) {
     if (waited.elapsedMs() > finish_timeout_s * 1000.0) {

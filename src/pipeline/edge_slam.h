@@ -4,8 +4,10 @@
 // link's thread, so tracking never waits for the network.
 #include <memory>
 #include <mutex>
+#include <optional>
 
 #include "client/edge_keyframe_sink.h"
+#include "pipeline/adaptation_loop.h"
 #include "pipeline/edge_link.h"
 #include "pipeline/slam_system.h"
 
@@ -13,21 +15,31 @@ namespace edgeslam {
 
 class EdgeSlam : public TrackingSlam {
  public:
-  EdgeSlam(const PinholeCamera& camera, SlamOptions options, std::unique_ptr<EdgeLink> link);
+  // With `adaptation` and a networked link, a probing loop retunes the keyframe rules and the
+  // pyramid (paper Table I) as the link changes.
+  EdgeSlam(const PinholeCamera& camera, SlamOptions options, std::unique_ptr<EdgeLink> link,
+           std::optional<AdaptationLoopOptions> adaptation = std::nullopt);
   ~EdgeSlam() override;
 
   // Waits (up to `timeout_s`) until every upload has been answered by a slice.
   void finish() override;
   SlamCounters counters() const override;
+  // nullptr without adaptation.
+  const AdaptationLoop* adaptation() const { return adaptation_.get(); }
   const char* modeName() const override { return "edge"; }
 
   double finish_timeout_s = 30.0;
 
  private:
   void onSlice(MapSlice slice);
+  void afterFrame() override;
+  void applyConfiguration(const KeyframeConfig& config);
 
   std::unique_ptr<EdgeLink> link_;
   std::unique_ptr<EdgeKeyFrameSink> sink_;
+  std::unique_ptr<AdaptationLoop> adaptation_;
+  std::uint64_t applied_config_version_ = 0;
+  std::uint64_t uploads_seen_ = 0;
   mutable std::mutex stats_mutex_;
   SampleStats slice_latency_ms_;
   SampleStats slice_apply_ms_;

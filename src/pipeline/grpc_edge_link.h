@@ -23,6 +23,7 @@ class GrpcEdgeLink : public EdgeLink {
   void close() override;
 
   EdgeClient& client() { return *client_; }
+  EdgeClient* edgeClient() override { return client_.get(); }
 
  private:
   void deliver(MapSlice slice);
