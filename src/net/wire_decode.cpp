@@ -8,9 +8,12 @@
 #include "features/scale_levels.h"
 #include "net/wire_convert.h"
 #include "net/wire_limits.h"
+#include "net/wire_packing.h"
 
 namespace edgeslam {
 namespace {
+
+using namespace wire_packing;
 
 constexpr float kOrbPatchSize = 31.f;
 constexpr std::size_t kDescriptorBytes = wire_limits::kDescriptorBytes;
@@ -44,16 +47,6 @@ void requireCount(std::size_t count, std::size_t limit, std::string_view what) {
   }
 }
 
-Eigen::Vector3d decodeVector3(const google::protobuf::RepeatedField<double>& values,
-                              std::string_view field) {
-  if (values.size() != 3) {
-    throw WireError(fmt::format("{} has {} values, expected 3", field, values.size()));
-  }
-  const Eigen::Vector3d v(values[0], values[1], values[2]);
-  if (!v.allFinite()) throw WireError(fmt::format("{} is not finite", field));
-  return v;
-}
-
 template <typename T>
 void requireEmptyOrN(const google::protobuf::RepeatedField<T>& values, std::size_t n,
                      std::string_view field) {
@@ -66,29 +59,98 @@ void requireEmptyOrN(const google::protobuf::RepeatedField<T>& values, std::size
 
 template <typename T>
 void requireN(const google::protobuf::RepeatedField<T>& values, std::size_t n,
-              std::string_view field) {
+              std::string_view field, std::string_view what) {
   const auto size = static_cast<std::size_t>(values.size());
-  if (size != n) {
-    throw WireError(fmt::format("{} has {} values for {} keypoints", field, size, n));
+  if (size != n) throw WireError(fmt::format("{} has {} values for {} {}", field, size, n, what));
+}
+
+std::vector<cv::KeyPoint> decodeKeyPoints(const v1::KeyPoints& in, const ScaleLevels& scales) {
+  const std::size_t n = in.count();
+  requireCount(n, wire_limits::kMaxKeypoints, "keypoints");
+  const std::uint32_t width = in.coordinate_bytes();
+  if (n > 0 && (width < 1 || width > 4)) {
+    throw WireError(fmt::format("keypoints.coordinate_bytes {} outside 1..4", width));
   }
+  const Column x(in.x(), n, static_cast<int>(width), "keypoints.x");
+  const Column y(in.y(), n, static_cast<int>(width), "keypoints.y");
+  const Column angle(in.angle(), n, 2, "keypoints.angle");
+  const bool octave_runs = in.octave_runs_size() > 0;
+  if (octave_runs && !in.octave().empty()) {
+    throw WireError("keypoints carry both octave and octave_runs");
+  }
+  const Column octave(in.octave(), octave_runs ? 0 : n, 1, "keypoints.octave");
+  std::vector<std::uint32_t> run_octaves;
+  if (octave_runs) {
+    if (in.octave_runs_size() > scales.numLevels()) {
+      throw WireError(fmt::format("keypoints.octave_runs has {} levels but the pyramid has {}",
+                                  in.octave_runs_size(), scales.numLevels()));
+    }
+    std::uint64_t total = 0;
+    for (const std::uint32_t run : in.octave_runs()) total += run;
+    if (total != n) {
+      throw WireError(fmt::format("keypoints.octave_runs add up to {} for {} keypoints", total, n));
+    }
+    run_octaves.reserve(n);
+    for (int level = 0; level < in.octave_runs_size(); ++level) {
+      run_octaves.insert(run_octaves.end(), in.octave_runs(level),
+                         static_cast<std::uint32_t>(level));
+    }
+  }
+  requireEmptyOrN(in.size(), n, "keypoints.size");
+  requireEmptyOrN(in.response(), n, "keypoints.response");
+  std::vector<cv::KeyPoint> out(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    cv::KeyPoint& kp = out[i];
+    const auto k = static_cast<int>(i);
+    // int64: origin + a 4-byte value cannot overflow.
+    kp.pt.x = static_cast<float>(
+        static_cast<double>(in.x_origin() + static_cast<std::int64_t>(x.unsignedAt(i))) /
+        kCoordinateSteps);
+    kp.pt.y = static_cast<float>(
+        static_cast<double>(in.y_origin() + static_cast<std::int64_t>(y.unsignedAt(i))) /
+        kCoordinateSteps);
+    kp.angle = static_cast<float>(static_cast<double>(angle.unsignedAt(i)) / kAngleStepsPerDegree);
+    const std::uint64_t level = octave_runs ? run_octaves[i] : octave.unsignedAt(i);
+    if (level >= static_cast<std::uint64_t>(scales.numLevels())) {
+      throw WireError(fmt::format("keypoint {} has octave {} but the pyramid has {} levels", i,
+                                  level, scales.numLevels()));
+    }
+    kp.octave = static_cast<int>(level);
+    kp.size = in.size_size() == 0 ? kOrbPatchSize * static_cast<float>(scales.scale(kp.octave))
+                                  : in.size(k);
+    kp.response = in.response_size() == 0 ? 0.f : in.response(k);
+    if (!std::isfinite(kp.size) || !std::isfinite(kp.response)) {
+      throw WireError(fmt::format("keypoint {} has a non-finite size or response", i));
+    }
+  }
+  return out;
+}
+
+std::vector<float> decodeDepth(const v1::KeyFrameFeatures& in, std::size_t n) {
+  if (!in.depth_mm().empty() && in.depth_size() != 0) {
+    throw WireError("depth travels both as depth_mm and as floats");
+  }
+  if (in.depth_size() != 0) {
+    requireN(in.depth(), n, "depth", "keypoints");
+    std::vector<float> out(in.depth().begin(), in.depth().end());
+    for (std::size_t i = 0; i < n; ++i) {
+      if (std::isnan(out[i])) throw WireError(fmt::format("depth of keypoint {} is NaN", i));
+    }
+    return out;
+  }
+  if (in.depth_mm().empty()) return {};
+  const Column mm(in.depth_mm(), n, 2, "depth_mm");
+  std::vector<float> out(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::uint64_t steps = mm.unsignedAt(i);
+    out[i] =
+        steps == 0 ? -1.f : static_cast<float>(static_cast<double>(steps) / kDepthStepsPerMetre);
+  }
+  return out;
 }
 
 KeyFrameFeaturesRecord decodeFeatures(const v1::KeyFrameFeatures& in) {
   KeyFrameFeaturesRecord out;
-  const v1::KeyPoints& kps = in.keypoints();
-  const auto n = static_cast<std::size_t>(kps.x_size());
-  requireCount(n, wire_limits::kMaxKeypoints, "keypoints");
-  requireN(kps.y(), n, "keypoints.y");
-  requireN(kps.angle(), n, "keypoints.angle");
-  requireN(kps.octave(), n, "keypoints.octave");
-  requireEmptyOrN(kps.size(), n, "keypoints.size");
-  requireEmptyOrN(kps.response(), n, "keypoints.response");
-  requireEmptyOrN(in.depth(), n, "depth");
-  requireEmptyOrN(in.right_u(), n, "right_u");
-  if (in.descriptors().size() != n * kDescriptorBytes) {
-    throw WireError(fmt::format("descriptors hold {} bytes, expected 32 x {} keypoints = {}",
-                                in.descriptors().size(), n, n * kDescriptorBytes));
-  }
   if (in.pyramid_levels() < 1 ||
       in.pyramid_levels() > static_cast<std::uint32_t>(wire_limits::kMaxPyramidLevels)) {
     throw WireError(fmt::format("pyramid_levels {} outside 1..{}", in.pyramid_levels(),
@@ -102,52 +164,57 @@ KeyFrameFeaturesRecord decodeFeatures(const v1::KeyFrameFeatures& in) {
   out.pyramid_levels = static_cast<int>(in.pyramid_levels());
   out.scale_factor = in.scale_factor();
   out.bf = in.bf();
-  const ScaleLevels scales(out.pyramid_levels, out.scale_factor);
-
-  out.keypoints.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const int k = static_cast<int>(i);
-    cv::KeyPoint& kp = out.keypoints[i];
-    kp.pt = {kps.x(k), kps.y(k)};
-    kp.angle = kps.angle(k);
-    if (!std::isfinite(kp.pt.x) || !std::isfinite(kp.pt.y) || !std::isfinite(kp.angle)) {
-      throw WireError(fmt::format("keypoint {} has a non-finite coordinate or angle", i));
-    }
-    if (kps.octave(k) >= in.pyramid_levels()) {
-      throw WireError(fmt::format("keypoint {} has octave {} but the pyramid has {} levels", i,
-                                  kps.octave(k), in.pyramid_levels()));
-    }
-    kp.octave = static_cast<int>(kps.octave(k));
-    kp.size = kps.size_size() == 0 ? kOrbPatchSize * static_cast<float>(scales.scale(kp.octave))
-                                   : kps.size(k);
-    kp.response = kps.response_size() == 0 ? 0.f : kps.response(k);
-    if (!std::isfinite(kp.size) || !std::isfinite(kp.response)) {
-      throw WireError(fmt::format("keypoint {} has a non-finite size or response", i));
-    }
+  out.keypoints =
+      decodeKeyPoints(in.keypoints(), ScaleLevels(out.pyramid_levels, out.scale_factor));
+  const std::size_t n = out.keypoints.size();
+  if (in.descriptors().size() != n * kDescriptorBytes) {
+    throw WireError(fmt::format("descriptors hold {} bytes, expected 32 x {} keypoints = {}",
+                                in.descriptors().size(), n, n * kDescriptorBytes));
   }
   out.descriptors.create(static_cast<int>(n), static_cast<int>(kDescriptorBytes), CV_8UC1);
   if (n > 0) std::memcpy(out.descriptors.data, in.descriptors().data(), n * kDescriptorBytes);
-  out.depth.assign(in.depth().begin(), in.depth().end());
-  out.right_u.assign(in.right_u().begin(), in.right_u().end());
-  for (std::size_t i = 0; i < out.depth.size(); ++i) {
-    if (std::isnan(out.depth[i])) throw WireError(fmt::format("depth of keypoint {} is NaN", i));
-  }
-  for (std::size_t i = 0; i < out.right_u.size(); ++i) {
-    if (std::isnan(out.right_u[i])) {
-      throw WireError(fmt::format("right_u of keypoint {} is NaN", i));
+  out.depth = decodeDepth(in, n);
+  if (in.right_u_from_depth()) {
+    if (in.right_u_size() != 0) throw WireError("right_u both sent and to be rebuilt from depth");
+    if (out.depth.empty()) throw WireError("right_u to be rebuilt from depth, but no depth");
+    out.right_u.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const float d = out.depth[i];
+      out.right_u[i] = d > 0.f ? out.keypoints[i].pt.x - out.bf / d : -1.f;
+    }
+  } else {
+    requireEmptyOrN(in.right_u(), n, "right_u");
+    out.right_u.assign(in.right_u().begin(), in.right_u().end());
+    for (std::size_t i = 0; i < out.right_u.size(); ++i) {
+      if (std::isnan(out.right_u[i])) {
+        throw WireError(fmt::format("right_u of keypoint {} is NaN", i));
+      }
     }
   }
   return out;
 }
 
-std::vector<std::uint64_t> decodeIds(const google::protobuf::RepeatedField<std::uint64_t>& ids,
-                                     std::size_t limit, std::string_view field) {
-  requireCount(static_cast<std::size_t>(ids.size()), limit, field);
-  std::vector<std::uint64_t> out(ids.begin(), ids.end());
-  for (std::size_t i = 0; i < out.size(); ++i) {
-    requireId(out[i], fmt::format("{}[{}]", field, i));
+// A list of ids sent as deltas (the first to 0); every id non-zero.
+std::vector<std::uint64_t> decodeIdDeltas(
+    const google::protobuf::RepeatedField<std::int64_t>& deltas, std::size_t limit,
+    std::string_view field) {
+  requireCount(static_cast<std::size_t>(deltas.size()), limit, field);
+  std::vector<std::uint64_t> out;
+  out.reserve(static_cast<std::size_t>(deltas.size()));
+  std::uint64_t previous = 0;
+  for (const std::int64_t delta : deltas) {
+    previous = applyIdDelta(previous, delta);
+    requireId(previous, fmt::format("{}[{}]", field, out.size()));
+    out.push_back(previous);
   }
   return out;
+}
+
+Eigen::Vector3d positionAt(const Column& column, std::size_t point) {
+  const Eigen::Vector3d position(column.floatAt(3 * point), column.floatAt(3 * point + 1),
+                                 column.floatAt(3 * point + 2));
+  if (!position.allFinite()) throw WireError("position is not finite");
+  return position;
 }
 
 }  // namespace
@@ -176,66 +243,138 @@ KeyFrameRecord fromProto(const v1::KeyFrame& in) {
     out.parent = in.parent();
     out.features = decodeFeatures(in.features());
     const std::size_t n = out.features.keypoints.size();
-    if (in.point_keypoint_index_size() != in.point_ids_size()) {
-      throw WireError(fmt::format("{} point keypoint indices for {} point ids",
-                                  in.point_keypoint_index_size(), in.point_ids_size()));
+    if (in.point_keypoint_gaps_size() != in.point_id_deltas_size()) {
+      throw WireError(fmt::format("{} point keypoint gaps for {} point id deltas",
+                                  in.point_keypoint_gaps_size(), in.point_id_deltas_size()));
     }
     out.point_ids.assign(n, kInvalidId);
-    for (int i = 0; i < in.point_ids_size(); ++i) {
-      const std::uint32_t index = in.point_keypoint_index(i);
+    std::uint64_t next_index = 0;  // keypoints increase: none is associated twice
+    std::uint64_t id = out.id;
+    for (int i = 0; i < in.point_id_deltas_size(); ++i) {
+      const std::uint64_t index = next_index + in.point_keypoint_gaps(i);
       if (index >= n) {
         throw WireError(fmt::format("point association {} names keypoint {} of {}", i, index, n));
       }
-      requireId(in.point_ids(i), fmt::format("point_ids[{}]", i));
-      if (out.point_ids[index] != kInvalidId) {
-        throw WireError(fmt::format("keypoint {} is associated with two map points", index));
-      }
-      out.point_ids[index] = in.point_ids(i);
+      id = applyIdDelta(id, in.point_id_deltas(i));
+      requireId(id, fmt::format("point id of association {}", i));
+      out.point_ids[index] = id;
+      next_index = index + 1;
     }
     return out;
   });
 }
 
-MapPointRecord fromProto(const v1::MapPoint& in) {
-  return within(fmt::format("map point {}", idText(in.id())), [&] {
-    MapPointRecord out;
-    requireId(in.id(), "id");
-    out.id = in.id();
-    out.position = decodeVector3(in.position(), "position");
-    out.normal = decodeVector3(in.normal(), "normal");
-    if (in.descriptor_bytes().size() != kDescriptorBytes) {
-      throw WireError(
-          fmt::format("descriptor holds {} bytes, expected 32", in.descriptor_bytes().size()));
-    }
-    std::memcpy(out.descriptor.data(), in.descriptor_bytes().data(), kDescriptorBytes);
-    requireFinite(in.min_distance(), "min_distance");
-    requireFinite(in.max_distance(), "max_distance");
-    if (in.min_distance() < 0.f || in.max_distance() < 0.f) {
-      throw WireError(
-          fmt::format("distance range [{}, {}] is negative", in.min_distance(), in.max_distance()));
-    }
-    out.min_distance = in.min_distance();
-    out.max_distance = in.max_distance();
-    out.reference_keyframe = in.reference_keyframe();
-    if (in.observation_keyframes_size() != in.observation_keypoints_size()) {
-      throw WireError(fmt::format("{} observation keyframes for {} observation keypoints",
-                                  in.observation_keyframes_size(),
-                                  in.observation_keypoints_size()));
-    }
-    requireCount(static_cast<std::size_t>(in.observation_keyframes_size()),
-                 wire_limits::kMaxObservations, "observations");
-    out.observations.resize(static_cast<std::size_t>(in.observation_keyframes_size()));
-    for (int i = 0; i < in.observation_keyframes_size(); ++i) {
-      requireId(in.observation_keyframes(i), fmt::format("observation {} keyframe", i));
-      if (in.observation_keypoints(i) >= wire_limits::kMaxKeypoints) {
-        throw WireError(fmt::format("observation {} names keypoint {} (limit {})", i,
-                                    in.observation_keypoints(i), wire_limits::kMaxKeypoints));
+std::vector<MapPointRecord> fromProto(const v1::MapPoints& in) {
+  const std::size_t n = in.count();
+  requireCount(n, wire_limits::kMaxPointsPerMessage, "points");
+  requireN(in.id_deltas(), n, "points.id_deltas", "points");
+  requireN(in.reference_deltas(), n, "points.reference_deltas", "points");
+  requireN(in.observation_counts(), n, "points.observation_counts", "points");
+  const Column positions(in.positions(), 3 * n, 4, "points.positions");
+  const bool with_appearance =
+      !in.normals().empty() || !in.descriptors().empty() || !in.distances().empty();
+  const Column normals(in.normals(), with_appearance ? 3 * n : 0, 2, "points.normals");
+  const Column descriptors(in.descriptors(), with_appearance ? n : 0,
+                           static_cast<int>(kDescriptorBytes), "points.descriptors");
+  const Column distances(in.distances(), with_appearance ? 2 * n : 0, 4, "points.distances");
+  std::uint64_t observations = 0;
+  for (const std::uint32_t count : in.observation_counts()) {
+    requireCount(count, wire_limits::kMaxObservations, "observations of a point");
+    observations += count;
+  }
+  if (observations != static_cast<std::uint64_t>(in.observation_keyframe_deltas_size()) ||
+      observations != static_cast<std::uint64_t>(in.observation_keypoints_size())) {
+    throw WireError(fmt::format(
+        "observation counts add up to {}, but {} observation keyframes and {} keypoints "
+        "were sent",
+        observations, in.observation_keyframe_deltas_size(), in.observation_keypoints_size()));
+  }
+  std::vector<MapPointRecord> out(n);
+  std::uint64_t id = 0;
+  std::uint64_t previous_first_keyframe = 0;
+  int next_observation = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto k = static_cast<int>(i);
+    id = applyIdDelta(id, in.id_deltas(k));
+    within(fmt::format("map point {}", idText(id)), [&] {
+      MapPointRecord& point = out[i];
+      requireId(id, "id");
+      point.id = id;
+      point.position = positionAt(positions, i);
+      if (with_appearance) {
+        point.normal = Eigen::Vector3d(normals.int16At(3 * i), normals.int16At(3 * i + 1),
+                                       normals.int16At(3 * i + 2)) /
+                       kNormalSteps;
+        std::memcpy(point.descriptor.data(), in.descriptors().data() + i * kDescriptorBytes,
+                    kDescriptorBytes);
+        point.min_distance = distances.floatAt(2 * i);
+        point.max_distance = distances.floatAt(2 * i + 1);
+        requireFinite(point.min_distance, "min_distance");
+        requireFinite(point.max_distance, "max_distance");
+        if (point.min_distance < 0.f || point.max_distance < 0.f) {
+          throw WireError(fmt::format("distance range [{}, {}] is negative", point.min_distance,
+                                      point.max_distance));
+        }
       }
-      out.observations[static_cast<std::size_t>(i)] = {in.observation_keyframes(i),
-                                                       in.observation_keypoints(i)};
-    }
-    return out;
-  });
+      point.observations.resize(in.observation_counts(k));
+      if (i == 0) previous_first_keyframe = id;
+      std::uint64_t keyframe = previous_first_keyframe;
+      for (std::size_t j = 0; j < point.observations.size(); ++j, ++next_observation) {
+        keyframe = applyIdDelta(keyframe, in.observation_keyframe_deltas(next_observation));
+        requireId(keyframe, fmt::format("observation {} keyframe", j));
+        const std::uint32_t keypoint = in.observation_keypoints(next_observation);
+        if (keypoint >= wire_limits::kMaxKeypoints) {
+          throw WireError(fmt::format("observation {} names keypoint {} (limit {})", j, keypoint,
+                                      wire_limits::kMaxKeypoints));
+        }
+        point.observations[j] = {keyframe, keypoint};
+      }
+      const std::uint64_t reference_base =
+          point.observations.empty() ? id : point.observations.front().keyframe;
+      if (!point.observations.empty())
+        previous_first_keyframe = point.observations.front().keyframe;
+      point.reference_keyframe = applyIdDelta(reference_base, in.reference_deltas(k));
+      return 0;
+    });
+  }
+  return out;
+}
+
+std::vector<PointPositionRecord> fromProto(const v1::PointPositions& in) {
+  const std::vector<std::uint64_t> ids =
+      decodeIdDeltas(in.id_deltas(), wire_limits::kMaxPointsPerMessage, "point_positions ids");
+  const Column positions(in.positions(), 3 * ids.size(), 4, "point_positions.positions");
+  std::vector<PointPositionRecord> out(ids.size());
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    out[i].id = ids[i];
+    out[i].position = within(fmt::format("moved point {}", idText(ids[i])),
+                             [&] { return positionAt(positions, i); });
+  }
+  return out;
+}
+
+std::vector<KeyFramePoseRecord> fromProto(const v1::KeyFramePoses& in) {
+  const std::vector<std::uint64_t> ids =
+      decodeIdDeltas(in.id_deltas(), wire_limits::kMaxKeyFramesPerSlice, "keyframe_poses ids");
+  requireN(in.parent_deltas(), ids.size(), "keyframe_poses.parent_deltas", "keyframe poses");
+  const Column values(in.poses(), kPoseFloats * ids.size(), 4, "keyframe_poses.poses");
+  std::vector<KeyFramePoseRecord> out(ids.size());
+  for (std::size_t i = 0; i < ids.size(); ++i) {
+    out[i].id = ids[i];
+    out[i].parent = applyIdDelta(ids[i], in.parent_deltas(static_cast<int>(i)));
+    v1::Pose pose;
+    const std::size_t base = kPoseFloats * i;
+    pose.set_qw(values.floatAt(base));
+    pose.set_qx(values.floatAt(base + 1));
+    pose.set_qy(values.floatAt(base + 2));
+    pose.set_qz(values.floatAt(base + 3));
+    pose.set_tx(values.floatAt(base + 4));
+    pose.set_ty(values.floatAt(base + 5));
+    pose.set_tz(values.floatAt(base + 6));
+    out[i].T_cw =
+        within(fmt::format("keyframe pose {}", idText(ids[i])), [&] { return fromProto(pose); });
+  }
+  return out;
 }
 
 KeyFrameUpload fromProto(const v1::KeyFrameUpload& in) {
@@ -245,10 +384,8 @@ KeyFrameUpload fromProto(const v1::KeyFrameUpload& in) {
     out.sequence = in.sequence();
     if (!in.has_keyframe()) throw WireError("keyframe is missing");
     out.keyframe = fromProto(in.keyframe());
-    requireCount(static_cast<std::size_t>(in.new_points_size()), wire_limits::kMaxPointsPerMessage,
-                 "new points");
-    out.new_points.reserve(static_cast<std::size_t>(in.new_points_size()));
-    for (const v1::MapPoint& point : in.new_points()) out.new_points.push_back(fromProto(point));
+    out.map_reset = in.map_reset();
+    out.new_points = within("new points", [&] { return fromProto(in.new_points()); });
     const std::string& encoding = in.image_encoding();
     if (encoding.empty() != in.image().empty() ||
         !(encoding.empty() || encoding == "jpeg" || encoding == "png")) {
@@ -259,18 +396,6 @@ KeyFrameUpload fromProto(const v1::KeyFrameUpload& in) {
     out.image_encoding = encoding;
     out.image_bytes.assign(in.image().begin(), in.image().end());
     out.acknowledged_slice = in.acknowledged_slice();
-    return out;
-  });
-}
-
-KeyFramePoseRecord fromProto(const v1::KeyFramePose& in) {
-  return within(fmt::format("keyframe pose {}", idText(in.id())), [&] {
-    KeyFramePoseRecord out;
-    requireId(in.id(), "id");
-    out.id = in.id();
-    if (!in.has_t_cw()) throw WireError("pose T_cw is missing");
-    out.T_cw = fromProto(in.t_cw());
-    out.parent = in.parent();
     return out;
   });
 }
@@ -307,18 +432,15 @@ MapSlice fromProto(const v1::MapSlice& in) {
     requireCount(static_cast<std::size_t>(in.keyframes_size()), wire_limits::kMaxKeyFramesPerSlice,
                  "keyframes");
     for (const v1::KeyFrame& kf : in.keyframes()) out.keyframes.push_back(fromProto(kf));
-    requireCount(static_cast<std::size_t>(in.points_upserted_size()),
-                 wire_limits::kMaxPointsPerMessage, "upserted points");
-    out.points_upserted.reserve(static_cast<std::size_t>(in.points_upserted_size()));
-    for (const v1::MapPoint& p : in.points_upserted()) out.points_upserted.push_back(fromProto(p));
+    out.newest_keyframe = in.newest_keyframe();
+    out.points_upserted =
+        within("upserted points", [&] { return fromProto(in.points_upserted()); });
+    out.point_positions = fromProto(in.point_positions());
     out.points_erased =
-        decodeIds(in.points_erased(), wire_limits::kMaxErasedPerSlice, "points_erased");
-    requireCount(static_cast<std::size_t>(in.keyframe_poses_size()),
-                 wire_limits::kMaxKeyFramesPerSlice, "keyframe poses");
-    for (const v1::KeyFramePose& p : in.keyframe_poses())
-      out.keyframe_poses.push_back(fromProto(p));
+        decodeIdDeltas(in.points_erased(), wire_limits::kMaxErasedPerSlice, "points_erased");
+    out.keyframe_poses = fromProto(in.keyframe_poses());
     out.keyframes_erased =
-        decodeIds(in.keyframes_erased(), wire_limits::kMaxErasedPerSlice, "keyframes_erased");
+        decodeIdDeltas(in.keyframes_erased(), wire_limits::kMaxErasedPerSlice, "keyframes_erased");
     out.reference_keyframe = in.reference_keyframe();
     if (in.has_reference_pose()) {
       out.reference_pose = within("reference pose", [&] { return fromProto(in.reference_pose()); });

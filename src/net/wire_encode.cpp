@@ -1,20 +1,20 @@
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
 
 #include "features/scale_levels.h"
 #include "net/wire_convert.h"
 #include "net/wire_limits.h"
+#include "net/wire_packing.h"
 
 namespace edgeslam {
 namespace {
 
-constexpr float kOrbPatchSize = 31.f;
+using namespace wire_packing;
 
-void setVector3(const Eigen::Vector3d& v, google::protobuf::RepeatedField<double>* out) {
-  out->Reserve(3);
-  for (int i = 0; i < 3; ++i) out->Add(v[i]);
-}
+constexpr float kOrbPatchSize = 31.f;
 
 bool sizesFollowOrbConvention(const KeyFrameFeaturesRecord& features) {
   if (features.pyramid_levels < 1 || !(features.scale_factor > 1.0)) return false;
@@ -24,6 +24,116 @@ bool sizesFollowOrbConvention(const KeyFrameFeaturesRecord& features) {
     if (kp.size != kOrbPatchSize * static_cast<float>(scales.scale(kp.octave))) return false;
   }
   return true;
+}
+
+// The RGB-D feature builder's rule: right_u = u - bf / depth where the depth is known, else -1.
+bool rightUFollowsDepth(const KeyFrameFeaturesRecord& features) {
+  if (features.right_u.empty() || features.depth.size() != features.keypoints.size()) return false;
+  for (std::size_t i = 0; i < features.keypoints.size(); ++i) {
+    const float d = features.depth[i];
+    const float expected = d > 0.f ? features.keypoints[i].pt.x - features.bf / d : -1.f;
+    if (features.right_u[i] != expected) return false;
+  }
+  return true;
+}
+
+int bytesFor(std::uint64_t max_value) {
+  int bytes = 1;
+  while (bytes < 8 && (max_value >> (8 * bytes)) != 0) ++bytes;
+  return bytes;
+}
+
+std::int64_t quantiseCoordinate(float value, std::size_t index, char axis, KeyFrameId id) {
+  if (!std::isfinite(value) || std::abs(value) > kMaxCoordinate) {
+    throw WireError(fmt::format("keyframe {:#x}: keypoint {} has {} = {}, outside +-{} px", id,
+                                index, axis, value, kMaxCoordinate));
+  }
+  return std::llround(static_cast<double>(value) * kCoordinateSteps);
+}
+
+void encodeKeyPoints(const KeyFrameFeaturesRecord& features, KeyFrameId id, v1::KeyPoints* out,
+                     const WireEncodeOptions& options) {
+  const std::vector<cv::KeyPoint>& keypoints = features.keypoints;
+  const std::size_t n = keypoints.size();
+  out->set_count(static_cast<std::uint32_t>(n));
+  if (n == 0) return;
+  std::vector<std::int64_t> xs(n);
+  std::vector<std::int64_t> ys(n);
+  std::string* angles = out->mutable_angle();
+  std::string* octaves = out->mutable_octave();
+  angles->reserve(2 * n);
+  octaves->reserve(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const cv::KeyPoint& kp = keypoints[i];
+    xs[i] = quantiseCoordinate(kp.pt.x, i, 'x', id);
+    ys[i] = quantiseCoordinate(kp.pt.y, i, 'y', id);
+    if (!std::isfinite(kp.angle)) {
+      throw WireError(fmt::format("keyframe {:#x}: keypoint {} has angle {}", id, i, kp.angle));
+    }
+    const double degrees = std::fmod(static_cast<double>(kp.angle), 360.0);  // a direction
+    const long steps = std::lround(degrees * kAngleStepsPerDegree);
+    putUnsigned(*angles, static_cast<std::uint64_t>(steps) & 0xffffu, 2);
+    if (kp.octave < 0 || kp.octave > 255) {
+      throw WireError(fmt::format("keyframe {:#x}: keypoint {} has octave {}", id, i, kp.octave));
+    }
+    putUnsigned(*octaves, static_cast<std::uint64_t>(kp.octave), 1);
+  }
+  const bool ordered_by_octave = std::is_sorted(
+      keypoints.begin(), keypoints.end(),
+      [](const cv::KeyPoint& a, const cv::KeyPoint& b) { return a.octave < b.octave; });
+  if (ordered_by_octave) {
+    octaves->clear();
+    for (const cv::KeyPoint& kp : keypoints) {
+      while (out->octave_runs_size() <= kp.octave) out->add_octave_runs(0);
+      out->set_octave_runs(kp.octave, out->octave_runs(kp.octave) + 1);
+    }
+  }
+  const auto [x_min, x_max] = std::minmax_element(xs.begin(), xs.end());
+  const auto [y_min, y_max] = std::minmax_element(ys.begin(), ys.end());
+  const int bytes =
+      bytesFor(static_cast<std::uint64_t>(std::max(*x_max - *x_min, *y_max - *y_min)));
+  out->set_x_origin(static_cast<std::int32_t>(*x_min));
+  out->set_y_origin(static_cast<std::int32_t>(*y_min));
+  out->set_coordinate_bytes(static_cast<std::uint32_t>(bytes));
+  std::string* x = out->mutable_x();
+  std::string* y = out->mutable_y();
+  x->reserve(n * static_cast<std::size_t>(bytes));
+  y->reserve(n * static_cast<std::size_t>(bytes));
+  for (std::size_t i = 0; i < n; ++i) {
+    putUnsigned(*x, static_cast<std::uint64_t>(xs[i] - *x_min), bytes);
+    putUnsigned(*y, static_cast<std::uint64_t>(ys[i] - *y_min), bytes);
+  }
+  const int count = static_cast<int>(n);
+  if (!sizesFollowOrbConvention(features)) {
+    out->mutable_size()->Reserve(count);
+    for (const cv::KeyPoint& kp : keypoints) out->add_size(kp.size);
+  }
+  if (options.keypoint_response) {
+    out->mutable_response()->Reserve(count);
+    for (const cv::KeyPoint& kp : keypoints) out->add_response(kp.response);
+  }
+}
+
+bool depthFitsMillimetres(const std::vector<float>& depth) {
+  return std::all_of(depth.begin(), depth.end(), [](float d) {
+    if (!(d > 0.f)) return true;  // unknown
+    const double steps = std::round(static_cast<double>(d) * kDepthStepsPerMetre);
+    return steps >= 1.0 && steps <= kMaxDepthSteps;
+  });
+}
+
+void encodeDepth(const KeyFrameFeaturesRecord& features, v1::KeyFrameFeatures* out) {
+  if (features.depth.empty()) return;
+  if (!depthFitsMillimetres(features.depth)) {
+    out->mutable_depth()->Add(features.depth.begin(), features.depth.end());
+    return;
+  }
+  std::string* mm = out->mutable_depth_mm();
+  mm->reserve(2 * features.depth.size());
+  for (const float d : features.depth) {
+    const double steps = d > 0.f ? std::round(static_cast<double>(d) * kDepthStepsPerMetre) : 0.0;
+    putUnsigned(*mm, static_cast<std::uint64_t>(steps), 2);
+  }
 }
 
 void encodeFeatures(const KeyFrameFeaturesRecord& features, KeyFrameId id,
@@ -45,37 +155,52 @@ void encodeFeatures(const KeyFrameFeaturesRecord& features, KeyFrameId id,
     throw WireError(fmt::format("keyframe {:#x}: {} right_u values for {} keypoints", id,
                                 features.right_u.size(), n));
   }
-  v1::KeyPoints* kps = out->mutable_keypoints();
-  const int count = static_cast<int>(n);
-  kps->mutable_x()->Reserve(count);
-  kps->mutable_y()->Reserve(count);
-  kps->mutable_angle()->Reserve(count);
-  kps->mutable_octave()->Reserve(count);
-  for (const cv::KeyPoint& kp : features.keypoints) {
-    kps->add_x(kp.pt.x);
-    kps->add_y(kp.pt.y);
-    kps->add_angle(kp.angle);
-    kps->add_octave(static_cast<std::uint32_t>(std::max(kp.octave, 0)));
-  }
-  if (!sizesFollowOrbConvention(features)) {
-    kps->mutable_size()->Reserve(count);
-    for (const cv::KeyPoint& kp : features.keypoints) kps->add_size(kp.size);
-  }
-  if (options.keypoint_response) {
-    kps->mutable_response()->Reserve(count);
-    for (const cv::KeyPoint& kp : features.keypoints) kps->add_response(kp.response);
-  }
+  encodeKeyPoints(features, id, out->mutable_keypoints(), options);
   std::string* bytes = out->mutable_descriptors();
   bytes->resize(n * wire_limits::kDescriptorBytes);
-  for (int row = 0; row < count; ++row) {
-    std::memcpy(bytes->data() + static_cast<std::size_t>(row) * wire_limits::kDescriptorBytes,
-                desc.ptr<std::uint8_t>(row), wire_limits::kDescriptorBytes);
+  for (std::size_t row = 0; row < n; ++row) {
+    std::memcpy(bytes->data() + row * wire_limits::kDescriptorBytes,
+                desc.ptr<std::uint8_t>(static_cast<int>(row)), wire_limits::kDescriptorBytes);
   }
-  out->mutable_depth()->Add(features.depth.begin(), features.depth.end());
-  out->mutable_right_u()->Add(features.right_u.begin(), features.right_u.end());
+  encodeDepth(features, out);
+  if (rightUFollowsDepth(features)) {
+    out->set_right_u_from_depth(true);
+  } else {
+    out->mutable_right_u()->Add(features.right_u.begin(), features.right_u.end());
+  }
   out->set_pyramid_levels(static_cast<std::uint32_t>(std::max(features.pyramid_levels, 0)));
   out->set_scale_factor(features.scale_factor);
   out->set_bf(features.bf);
+}
+
+void putPosition(std::string& out, const Eigen::Vector3d& position, std::uint64_t id) {
+  for (int k = 0; k < 3; ++k) {
+    const auto value = static_cast<float>(position[k]);
+    if (!std::isfinite(value)) {
+      throw WireError(fmt::format("map point {:#x}: position ({}, {}, {}) is not finite in float32",
+                                  id, position.x(), position.y(), position.z()));
+    }
+    putFloat(out, value);
+  }
+}
+
+void putNormal(std::string& out, const Eigen::Vector3d& normal) {
+  const double norm = normal.norm();
+  // A direction: travels normalised (a zero normal, not yet computed, stays zero).
+  const Eigen::Vector3d unit =
+      std::isfinite(norm) && norm > 0.0 ? Eigen::Vector3d(normal / norm) : Eigen::Vector3d::Zero();
+  for (int k = 0; k < 3; ++k) {
+    const long steps = std::lround(std::clamp(unit[k], -1.0, 1.0) * kNormalSteps);
+    putUnsigned(out, static_cast<std::uint64_t>(steps) & 0xffffu, 2);
+  }
+}
+
+void putPose(std::string& out, const SE3d& pose) {
+  const Eigen::Quaterniond& q = pose.rotation();
+  const Eigen::Vector3d& t = pose.translation();
+  for (const double value : {q.w(), q.x(), q.y(), q.z(), t.x(), t.y(), t.z()}) {
+    putFloat(out, static_cast<float>(value));
+  }
 }
 
 }  // namespace
@@ -104,27 +229,84 @@ void toProto(const KeyFrameRecord& keyframe, v1::KeyFrame* out, const WireEncode
     throw WireError(fmt::format("keyframe {:#x}: {} point ids for {} keypoints", keyframe.id,
                                 keyframe.point_ids.size(), keyframe.features.keypoints.size()));
   }
+  std::size_t next_index = 0;
+  std::uint64_t previous_id = keyframe.id;
   for (std::size_t i = 0; i < keyframe.point_ids.size(); ++i) {
     if (keyframe.point_ids[i] == kInvalidId) continue;
-    out->add_point_keypoint_index(static_cast<std::uint32_t>(i));
-    out->add_point_ids(keyframe.point_ids[i]);
+    out->add_point_keypoint_gaps(static_cast<std::uint32_t>(i - next_index));
+    out->add_point_id_deltas(idDelta(keyframe.point_ids[i], previous_id));
+    next_index = i + 1;
+    previous_id = keyframe.point_ids[i];
   }
 }
 
-void toProto(const MapPointRecord& point, v1::MapPoint* out) {
-  out->set_id(point.id);
-  setVector3(point.position, out->mutable_position());
-  setVector3(point.normal, out->mutable_normal());
-  out->set_descriptor_bytes(point.descriptor.data(), point.descriptor.size());
-  out->set_min_distance(point.min_distance);
-  out->set_max_distance(point.max_distance);
-  out->set_reference_keyframe(point.reference_keyframe);
-  const int count = static_cast<int>(point.observations.size());
-  out->mutable_observation_keyframes()->Reserve(count);
-  out->mutable_observation_keypoints()->Reserve(count);
-  for (const PointObservationRecord& obs : point.observations) {
-    out->add_observation_keyframes(obs.keyframe);
-    out->add_observation_keypoints(obs.keypoint_index);
+void toProto(const std::vector<MapPointRecord>& points, v1::MapPoints* out, bool with_appearance) {
+  const std::size_t n = points.size();
+  out->set_count(static_cast<std::uint32_t>(n));
+  if (n == 0) return;
+  const int count = static_cast<int>(n);
+  out->mutable_id_deltas()->Reserve(count);
+  out->mutable_reference_deltas()->Reserve(count);
+  out->mutable_observation_counts()->Reserve(count);
+  std::string* positions = out->mutable_positions();
+  positions->reserve(12 * n);
+  std::uint64_t previous_id = 0;
+  std::uint64_t previous_first_keyframe = points.front().id;
+  for (const MapPointRecord& point : points) {
+    out->add_id_deltas(idDelta(point.id, previous_id));
+    previous_id = point.id;
+    putPosition(*positions, point.position, point.id);
+    out->add_observation_counts(static_cast<std::uint32_t>(point.observations.size()));
+    std::uint64_t previous_keyframe = previous_first_keyframe;
+    for (const PointObservationRecord& obs : point.observations) {
+      out->add_observation_keyframe_deltas(idDelta(obs.keyframe, previous_keyframe));
+      out->add_observation_keypoints(obs.keypoint_index);
+      previous_keyframe = obs.keyframe;
+    }
+    const std::uint64_t reference_base =
+        point.observations.empty() ? point.id : point.observations.front().keyframe;
+    if (!point.observations.empty()) previous_first_keyframe = point.observations.front().keyframe;
+    out->add_reference_deltas(idDelta(point.reference_keyframe, reference_base));
+  }
+  if (!with_appearance) return;
+  std::string* normals = out->mutable_normals();
+  std::string* descriptors = out->mutable_descriptors();
+  std::string* distances = out->mutable_distances();
+  normals->reserve(6 * n);
+  descriptors->reserve(wire_limits::kDescriptorBytes * n);
+  distances->reserve(8 * n);
+  for (const MapPointRecord& point : points) {
+    putNormal(*normals, point.normal);
+    descriptors->append(reinterpret_cast<const char*>(point.descriptor.data()),
+                        point.descriptor.size());
+    putFloat(*distances, point.min_distance);
+    putFloat(*distances, point.max_distance);
+  }
+}
+
+void toProto(const std::vector<PointPositionRecord>& positions, v1::PointPositions* out) {
+  out->mutable_id_deltas()->Reserve(static_cast<int>(positions.size()));
+  std::string* bytes = out->mutable_positions();
+  bytes->reserve(12 * positions.size());
+  std::uint64_t previous_id = 0;
+  for (const PointPositionRecord& record : positions) {
+    out->add_id_deltas(idDelta(record.id, previous_id));
+    previous_id = record.id;
+    putPosition(*bytes, record.position, record.id);
+  }
+}
+
+void toProto(const std::vector<KeyFramePoseRecord>& poses, v1::KeyFramePoses* out) {
+  out->mutable_id_deltas()->Reserve(static_cast<int>(poses.size()));
+  out->mutable_parent_deltas()->Reserve(static_cast<int>(poses.size()));
+  std::string* bytes = out->mutable_poses();
+  bytes->reserve(4 * kPoseFloats * poses.size());
+  std::uint64_t previous_id = 0;
+  for (const KeyFramePoseRecord& record : poses) {
+    out->add_id_deltas(idDelta(record.id, previous_id));
+    previous_id = record.id;
+    out->add_parent_deltas(idDelta(record.parent, record.id));
+    putPose(*bytes, record.T_cw);
   }
 }
 
@@ -132,17 +314,13 @@ void toProto(const KeyFrameUpload& upload, v1::KeyFrameUpload* out,
              const WireEncodeOptions& options) {
   out->set_sequence(upload.sequence);
   toProto(upload.keyframe, out->mutable_keyframe(), options);
-  out->mutable_new_points()->Reserve(static_cast<int>(upload.new_points.size()));
-  for (const MapPointRecord& point : upload.new_points) toProto(point, out->add_new_points());
+  if (!upload.new_points.empty()) {
+    toProto(upload.new_points, out->mutable_new_points(), options.upload_point_appearance);
+  }
   out->set_image_encoding(upload.image_encoding);
   out->set_image(upload.image_bytes.data(), upload.image_bytes.size());
   out->set_acknowledged_slice(upload.acknowledged_slice);
-}
-
-void toProto(const KeyFramePoseRecord& pose, v1::KeyFramePose* out) {
-  out->set_id(pose.id);
-  toProto(pose.T_cw, out->mutable_t_cw());
-  out->set_parent(pose.parent);
+  out->set_map_reset(upload.map_reset);
 }
 
 void toProto(const MaskRecord& mask, v1::Mask* out) {
@@ -157,16 +335,27 @@ void toProto(const MapSlice& slice, v1::MapSlice* out, const WireEncodeOptions& 
   out->set_sequence(slice.sequence);
   out->set_upload_sequence(slice.upload_sequence);
   out->set_processed_keyframe(slice.processed_keyframe);
+  out->set_newest_keyframe(slice.newest_keyframe);
   out->set_full_resync(slice.full_resync);
   out->mutable_keyframes()->Reserve(static_cast<int>(slice.keyframes.size()));
   for (const KeyFrameRecord& kf : slice.keyframes) toProto(kf, out->add_keyframes(), options);
-  out->mutable_points_upserted()->Reserve(static_cast<int>(slice.points_upserted.size()));
-  for (const MapPointRecord& p : slice.points_upserted) toProto(p, out->add_points_upserted());
-  out->mutable_points_erased()->Add(slice.points_erased.begin(), slice.points_erased.end());
-  out->mutable_keyframe_poses()->Reserve(static_cast<int>(slice.keyframe_poses.size()));
-  for (const KeyFramePoseRecord& p : slice.keyframe_poses) toProto(p, out->add_keyframe_poses());
-  out->mutable_keyframes_erased()->Add(slice.keyframes_erased.begin(),
-                                       slice.keyframes_erased.end());
+  if (!slice.points_upserted.empty()) {
+    toProto(slice.points_upserted, out->mutable_points_upserted(), /*with_appearance=*/true);
+  }
+  if (!slice.point_positions.empty()) {
+    toProto(slice.point_positions, out->mutable_point_positions());
+  }
+  std::uint64_t previous = 0;
+  for (const MapPointId id : slice.points_erased) {
+    out->add_points_erased(idDelta(id, previous));
+    previous = id;
+  }
+  if (!slice.keyframe_poses.empty()) toProto(slice.keyframe_poses, out->mutable_keyframe_poses());
+  previous = 0;
+  for (const KeyFrameId id : slice.keyframes_erased) {
+    out->add_keyframes_erased(idDelta(id, previous));
+    previous = id;
+  }
   out->set_reference_keyframe(slice.reference_keyframe);
   if (slice.reference_pose) toProto(*slice.reference_pose, out->mutable_reference_pose());
   for (const MaskRecord& mask : slice.masks) toProto(mask, out->add_masks());

@@ -92,9 +92,13 @@ inline MapSlice sampleSlice(std::uint64_t sequence, std::mt19937& rng) {
   s.sequence = sequence;
   s.upload_sequence = sequence + 2;
   s.processed_keyframe = clientId(3, 77);
+  s.newest_keyframe = clientId(3, 79);
   s.full_resync = true;
   s.keyframes.push_back(sampleKeyFrame(clientId(0, 9), 20, rng, false));
   for (int i = 0; i < 5; ++i) s.points_upserted.push_back(samplePoint(clientId(0, 300 + i), rng));
+  for (int i = 0; i < 3; ++i) {
+    s.point_positions.push_back({clientId(3, 400 + i), samplePoint(1, rng).position});
+  }
   s.points_erased = {clientId(3, 4), clientId(0, 5)};
   s.keyframe_poses.push_back({clientId(3, 8), samplePose(rng), clientId(3, 7)});
   s.keyframe_poses.push_back({clientId(0, 9), samplePose(rng), kInvalidId});
