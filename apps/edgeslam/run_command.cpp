@@ -24,6 +24,7 @@
 #include "progress_line.h"
 #include "run_options.h"
 #include "util/timing_stats.h"
+#include "vocabulary_option.h"
 
 namespace edgeslam::cli {
 namespace {
@@ -60,32 +61,6 @@ std::optional<nlohmann::json> ateJson(const Trajectory& gt, const Trajectory& es
                         {"align", toString(align)}};
 }
 
-std::shared_ptr<const Vocabulary> loadVocabulary(const std::string& requested) {
-  if (requested == "none") return nullptr;
-  std::filesystem::path path = requested;
-  if (path.empty()) {
-    if (const char* env = std::getenv("EDGESLAM_VOCAB")) {
-      path = env;
-    } else {
-      std::error_code error;
-      const auto binary = std::filesystem::read_symlink("/proc/self/exe", error);
-      if (!error) path = binary.parent_path() / "vocab" / "orb_k10_l5.vocab";
-    }
-    if (path.empty() || !std::filesystem::exists(path)) {
-      spdlog::warn(
-          "no vocabulary ({}): relocalisation tries recent keyframes only and loops are not "
-          "closed; `make vocab` trains one, --vocab FILE names one",
-          path.empty() ? "none found" : path.string() + " missing");
-      return nullptr;
-    }
-  }
-  Stopwatch timer;
-  auto vocabulary = std::make_shared<const Vocabulary>(Vocabulary::load(path));
-  spdlog::info("vocabulary {}: {} words, loaded in {:.0f} ms", path.string(),
-               vocabulary->wordCount(), timer.elapsedMs());
-  return vocabulary;
-}
-
 Sensor toSensor(const std::string& name) {
   if (name == "rgbd") return Sensor::kRgbd;
   if (name == "stereo") return Sensor::kStereo;
@@ -99,7 +74,7 @@ struct EdgeEndpoint {
   std::string address;
 };
 
-EdgeEndpoint openEdge(const RunOptions& options) {
+EdgeEndpoint openEdge(const RunOptions& options, std::shared_ptr<const Vocabulary> vocabulary) {
   EdgeEndpoint edge;
   if (!options.server_address.empty()) {
     edge.address = options.server_address;
@@ -111,7 +86,10 @@ EdgeEndpoint openEdge(const RunOptions& options) {
   }
   std::optional<LinkSettings> link;
   if (options.link != "none") link = linkProfile(options.link);
-  edge.embedded = std::make_unique<EmbeddedEdge>(SlamSessionOptions{}, link);
+  SlamSessionOptions session;
+  session.mapping.vocabulary = std::move(vocabulary);
+  session.mapping.loop_closing = options.loop_closing;
+  edge.embedded = std::make_unique<EmbeddedEdge>(session, link);
   edge.address = edge.embedded->clientAddress();
   spdlog::info("edge server on loopback, client connects to {}{}", edge.address,
                link ? " through link " + link->describe() : std::string());
@@ -182,10 +160,13 @@ int runPipeline(const RunOptions& options) {
   if (options.starving) kf.starving_ratio = *options.starving;
   slam_options.orb.validate();
   slam_options.tracker.vocabulary = loadVocabulary(options.vocabulary);
+  slam_options.vocabulary = slam_options.tracker.vocabulary;
+  slam_options.loop_closing = options.loop_closing;
   spdlog::info("{} ORB features, {} levels; keyframes fmin {} fmax {} alpha {} beta {}",
                slam_options.orb.num_features, slam_options.orb.num_levels, kf.fmin, kf.fmax,
                kf.alpha, kf.beta);
-  const EdgeEndpoint edge = mode == "local" ? EdgeEndpoint{} : openEdge(options);
+  const EdgeEndpoint edge =
+      mode == "local" ? EdgeEndpoint{} : openEdge(options, slam_options.vocabulary);
   const std::unique_ptr<SlamSystem> slam_system =
       makeSlamSystem(options, mode, reader->camera(), sensor, slam_options, edge);
   SlamSystem& slam = *slam_system;
@@ -363,6 +344,9 @@ void addRunOptions(CLI::App* run, const std::shared_ptr<RunOptions>& options) {
   run->add_option("--vocab", options->vocabulary,
                   "Vocabulary file for relocalisation and loops (default: vocab/ next to the "
                   "binary or $EDGESLAM_VOCAB; none = without)");
+  run->add_option("--loops", options->loop_closing, "Loop closing on|off (needs a vocabulary)")
+      ->transform(
+          CLI::CheckedTransformer(std::map<std::string, bool>{{"on", true}, {"off", false}}));
   run->add_option("--features", options->features,
                   "ORB features per frame (default 1000, 2000 above 640x480)")
       ->check(CLI::Range(100, 20000));

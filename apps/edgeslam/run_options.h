@@ -25,6 +25,7 @@ struct RunOptions {
   // Bag-of-words vocabulary for relocalisation and loop closing; "" = the default file next to the
   // binary (vocab/orb_k10_l5.vocab) when present, "none" = without.
   std::string vocabulary;
+  bool loop_closing = true;
   // Tuning; unset values keep the defaults (Table I row 1 for local tracking).
   std::optional<int> features;
   std::optional<int> levels;

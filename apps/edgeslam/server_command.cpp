@@ -9,6 +9,7 @@
 
 #include "commands.h"
 #include "pipeline/slam_session_backend.h"
+#include "vocabulary_option.h"
 
 namespace edgeslam::cli {
 namespace {
@@ -19,8 +20,10 @@ void requestStop(int) {
   g_stop = true;
 }
 
-int runServer(const std::string& listen, int status_interval_s) {
-  EdgeServer server(listen, std::make_shared<SlamSessionFactory>());
+int runServer(const std::string& listen, int status_interval_s, const std::string& vocabulary) {
+  SlamSessionOptions options;
+  options.mapping.vocabulary = loadVocabulary(vocabulary);
+  EdgeServer server(listen, std::make_shared<SlamSessionFactory>(options));
   spdlog::info("edge server listening on {} (Ctrl-C to stop)", server.address());
   std::signal(SIGINT, requestStop);
   std::signal(SIGTERM, requestStop);
@@ -45,10 +48,14 @@ int runServer(const std::string& listen, int status_interval_s) {
 void addServerCommand(CLI::App& app) {
   auto listen = std::make_shared<std::string>("0.0.0.0:50051");
   auto interval = std::make_shared<int>(10);
+  auto vocabulary = std::make_shared<std::string>();
   auto* cmd = app.add_subcommand("server", "The edge server: global maps for many client sessions");
   cmd->add_option("--listen", *listen, "HOST:PORT to listen on (port 0 = any free port)");
   cmd->add_option("--status-every", *interval, "Seconds between session status lines (0 = none)");
-  cmd->callback([listen, interval] { exitCode() = runServer(*listen, *interval); });
+  cmd->add_option("--vocab", *vocabulary,
+                  "Vocabulary for loop closing (default: vocab/ next to the binary; none = off)");
+  cmd->callback(
+      [listen, interval, vocabulary] { exitCode() = runServer(*listen, *interval, *vocabulary); });
 }
 
 const CommandRegistration kServerCommandRegistration{15, addServerCommand};

@@ -14,7 +14,18 @@ EdgeMapSession::EdgeMapSession(const PinholeCamera& camera, Sensor sensor,
     : camera_(camera), publish_(std::move(publish)), threaded_(options.threaded) {
   options.mapper.monocular = sensor == Sensor::kMonocular;
   mapper_ = std::make_unique<LocalMapper>(map_, camera_, options.mapper);
-  mapper_->setKeyFrameMappedCallback([this](KeyFrame* kf) { publishSlice(kf); });
+  if (options.vocabulary != nullptr && options.loop_closing) {
+    LoopCloserOptions loop = loopCloserOptionsFor(sensor);
+    loop.threaded = threaded_;
+    loop_closer_ =
+        std::make_unique<LoopCloser>(map_, camera_, options.vocabulary, loop, mapper_.get());
+    loop_closer_->setMapCorrectedCallback([this] { publishSlice(nullptr); });
+    loop_closer_->start();
+  }
+  mapper_->setKeyFrameMappedCallback([this](KeyFrame* kf) {
+    publishSlice(kf);
+    if (loop_closer_) loop_closer_->insertKeyFrame(kf);
+  });
   if (threaded_) mapper_->start();
 }
 
@@ -23,6 +34,7 @@ EdgeMapSession::~EdgeMapSession() {
 }
 
 void EdgeMapSession::stop() {
+  if (loop_closer_) loop_closer_->stop();
   mapper_->stop();
 }
 
@@ -32,6 +44,7 @@ void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
     std::lock_guard lock(map_.updateMutex());
     if (upload.map_reset) {
       mapper_->onMapReset();
+      if (loop_closer_) loop_closer_->onMapReset();
       map_.clear();
     }
     // The client already has what it sent: apply it without recording it for the slices.
@@ -55,22 +68,33 @@ void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
     newest_keyframe_ = keyframe->id();
   }
   mapper_->insertKeyFrame(keyframe);
-  if (!threaded_) mapper_->processAll();
+  if (!threaded_) {
+    mapper_->processAll();
+    if (loop_closer_) loop_closer_->processAll();
+  }
 }
 
 void EdgeMapSession::publishSlice(KeyFrame* mapped) {
+  std::lock_guard publishing(publish_mutex_);
   MapSlice slice;
   {
     std::lock_guard lock(map_.updateMutex());
+    const std::size_t loops = loop_closer_ ? loop_closer_->loops() : 0;
+    if (mapped == nullptr && map_.changes().empty() && loops == loops_published_) return;
     slice = buildSlice(map_, map_.takeChanges());
-    slice.processed_keyframe = mapped->id();
-    if (!mapped->isBad()) {
-      slice.reference_keyframe = mapped->id();
-      slice.reference_pose = mapped->pose();
+    if (mapped != nullptr) {
+      slice.processed_keyframe = mapped->id();
+      if (!mapped->isBad()) {
+        slice.reference_keyframe = mapped->id();
+        slice.reference_pose = mapped->pose();
+      }
     }
+    slice.loops_closed = static_cast<std::uint32_t>(loops - loops_published_);
+    loops_published_ = loops;
     std::lock_guard state(state_mutex_);
     slice.sequence = ++slice_sequence_;
-    slice.upload_sequence = last_upload_sequence_;
+    // A correction answers no upload.
+    slice.upload_sequence = mapped != nullptr ? last_upload_sequence_ : 0;
     slice.newest_keyframe = newest_keyframe_;
     ++stats_.slices;
     stats_.keyframes = map_.keyFrameCount();
@@ -81,6 +105,7 @@ void EdgeMapSession::publishSlice(KeyFrame* mapped) {
 
 void EdgeMapSession::finish() {
   mapper_->waitUntilIdle();
+  if (loop_closer_) loop_closer_->waitUntilIdle();
 }
 
 EdgeMapSessionStats EdgeMapSession::stats() const {

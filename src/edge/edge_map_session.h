@@ -1,6 +1,7 @@
 #pragma once
 // One client's session on the edge: the global map, fed by the client's keyframe uploads and kept
-// by local mapping on its own thread; after each mapped keyframe, what changed goes back to the
+// by local mapping on its own thread and, with a vocabulary, by loop closing on another; after each
+// mapped keyframe, loop correction and global bundle adjustment, what changed goes back to the
 // client as a map slice.
 #include <cstdint>
 #include <functional>
@@ -8,6 +9,7 @@
 #include <mutex>
 
 #include "edge/local_mapper.h"
+#include "edge/loop_closer.h"
 #include "geometry/camera.h"
 #include "map/map.h"
 #include "map/map_records.h"
@@ -18,6 +20,8 @@ namespace edgeslam {
 struct EdgeMapSessionOptions {
   LocalMapperOptions mapper;
   bool threaded = true;  // false: map each keyframe inside onKeyFrame (deterministic tests)
+  std::shared_ptr<const Vocabulary> vocabulary;
+  bool loop_closing = true;  // with a vocabulary
 };
 
 struct EdgeMapSessionStats {
@@ -46,21 +50,28 @@ class EdgeMapSession {
 
   EdgeMapSessionStats stats() const;
   Map& map() { return map_; }
+  // nullptr without a vocabulary or with loop closing off.
+  const LoopCloser* loopCloser() const { return loop_closer_.get(); }
 
  private:
+  // `mapped`: the keyframe just mapped, or nullptr for a loop correction or global BA.
   void publishSlice(KeyFrame* mapped);
 
   PinholeCamera camera_;
   Map map_;
   std::unique_ptr<LocalMapper> mapper_;
+  std::unique_ptr<LoopCloser> loop_closer_;
   Publish publish_;
   bool threaded_;
 
+  // Mapping and loop closing publish from their own threads: slices leave in sequence order.
+  std::mutex publish_mutex_;
   mutable std::mutex state_mutex_;  // guards the fields below (not the map)
   std::uint64_t slice_sequence_ = 0;
   std::uint64_t last_upload_sequence_ = 0;
   KeyFrameId newest_keyframe_ = kInvalidId;
   EdgeMapSessionStats stats_;
+  std::size_t loops_published_ = 0;
 };
 
 }  // namespace edgeslam

@@ -8,10 +8,12 @@
 
 #include "client/tracker.h"
 #include "edge/local_mapper.h"
+#include "edge/loop_closer.h"
 #include "features/frame_features_builder.h"
 #include "features/orb_extractor.h"
 #include "io/trajectory.h"
 #include "map/map.h"
+#include "place/vocabulary.h"
 #include "util/timing_stats.h"
 
 namespace edgeslam {
@@ -23,6 +25,12 @@ struct SlamOptions {
   LocalMapperOptions mapper;
   DepthOptions depth;
   bool threaded_mapping = true;  // local mode, false: map each keyframe before the next frame
+  // Loop closing runs where the global map is mapped (local mode: in-process; edge mode: on the
+  // edge) when a vocabulary is given and it is switched on.
+  std::shared_ptr<const Vocabulary> vocabulary;
+  bool loop_closing = true;
+  // Scale fixing follows `sensor` and threading `threaded_mapping`; the rest is used as is.
+  LoopCloserOptions loop_closer;
 };
 
 // Sensible defaults for a camera: 1000 features up to 640x480-ish, 2000 for wide images (KITTI).
