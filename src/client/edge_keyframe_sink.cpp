@@ -41,6 +41,8 @@ void EdgeKeyFrameSink::onMapReset() {
   std::lock_guard lock(map_.updateMutex());
   reset_pending_ = true;
   uploaded_points_.clear();
+  // The edge drops what it had not mapped yet: no slice will answer those uploads.
+  answered_ = sequence_.load();
 }
 
 double EdgeKeyFrameSink::onSliceApplied(std::uint64_t upload_sequence,

@@ -64,7 +64,7 @@ void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
     map_.setChangeRecording(true);
     std::lock_guard state(state_mutex_);
     ++stats_.uploads;
-    last_upload_sequence_ = upload.sequence;
+    upload_of_keyframe_[keyframe->id()] = upload.sequence;
     newest_keyframe_ = keyframe->id();
   }
   mapper_->insertKeyFrame(keyframe);
@@ -94,7 +94,15 @@ void EdgeMapSession::publishSlice(KeyFrame* mapped) {
     std::lock_guard state(state_mutex_);
     slice.sequence = ++slice_sequence_;
     // A correction answers no upload.
-    slice.upload_sequence = mapped != nullptr ? last_upload_sequence_ : 0;
+    // The slice answers the upload of the keyframe it mapped (later uploads may be queued).
+    slice.upload_sequence = 0;
+    if (mapped != nullptr) {
+      const auto it = upload_of_keyframe_.find(mapped->id());
+      if (it != upload_of_keyframe_.end()) {
+        slice.upload_sequence = it->second;
+        upload_of_keyframe_.erase(it);
+      }
+    }
     slice.newest_keyframe = newest_keyframe_;
     ++stats_.slices;
     stats_.keyframes = map_.keyFrameCount();

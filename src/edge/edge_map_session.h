@@ -7,6 +7,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <unordered_map>
 
 #include "edge/local_mapper.h"
 #include "edge/loop_closer.h"
@@ -68,7 +69,7 @@ class EdgeMapSession {
   std::mutex publish_mutex_;
   mutable std::mutex state_mutex_;  // guards the fields below (not the map)
   std::uint64_t slice_sequence_ = 0;
-  std::uint64_t last_upload_sequence_ = 0;
+  std::unordered_map<KeyFrameId, std::uint64_t> upload_of_keyframe_;
   KeyFrameId newest_keyframe_ = kInvalidId;
   EdgeMapSessionStats stats_;
   std::size_t loops_published_ = 0;
