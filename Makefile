@@ -46,10 +46,12 @@ test: test-release
 demo: vocab
 	@./$(BUILD_DIR)/edgeslam run --dataset "$(EDGESLAM_DATA)" --mode edge --out $(DEMO_OUT) $(DEMO_ARGS)
 
-# Micro-benchmarks (pinned to core 0), then the SLAM rows of docs/benchmarks.md (3 runs each).
+# Micro-benchmarks (pinned to core 0), the SLAM rows of docs/benchmarks.md in the three modes (3 runs
+# each), then the link experiments (every profile, adaptation on/off, offload; figures in docs/figures).
 bench: build
 	@BUILD_DIR=$(BUILD_DIR) bash bench/run.sh
-	@python3 bench/slam_bench.py --build $(BUILD_DIR) --shared $(EDGESLAM_SHARED)
+	@python3 bench/slam_bench.py --build $(BUILD_DIR) --shared $(EDGESLAM_SHARED) --modes local,edge,offload
+	@python3 bench/link_experiments.py --build-dir $(BUILD_DIR)
 
 format:
 	@git ls-files '*.cpp' '*.h' | xargs clang-format -i
