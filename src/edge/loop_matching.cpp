@@ -121,20 +121,20 @@ int searchByProjectionSim3(const KeyFrame& keyframe, const Sim3d& S_cw, const Pi
                            float radius, int max_distance) {
   requireSlots(keyframe, matched, "searchByProjectionSim3");
   std::unordered_set<const MapPoint*> already(matched.begin(), matched.end());
-  std::vector<MapPoint*> todo;
-  todo.reserve(points.size());
+  std::vector<MapPoint*> unmatched;
+  unmatched.reserve(points.size());
   for (MapPoint* p : points) {
-    if (p != nullptr && !p->isBad() && !already.contains(p)) todo.push_back(p);
+    if (p != nullptr && !p->isBad() && !already.contains(p)) unmatched.push_back(p);
   }
   std::vector<char> free(matched.size(), 0);
   for (std::size_t i = 0; i < matched.size(); ++i) free[i] = matched[i] == nullptr;
   const std::vector<int> best =
-      searchProjectedPoints(keyframe, S_cw.toSE3(), camera, todo, radius, max_distance, free);
+      searchProjectedPoints(keyframe, S_cw.toSE3(), camera, unmatched, radius, max_distance, free);
   int added = 0;
-  for (std::size_t k = 0; k < todo.size(); ++k) {
+  for (std::size_t k = 0; k < unmatched.size(); ++k) {
     const int i = best[k];
     if (i < 0 || matched[static_cast<std::size_t>(i)] != nullptr) continue;
-    matched[static_cast<std::size_t>(i)] = todo[k];
+    matched[static_cast<std::size_t>(i)] = unmatched[k];
     ++added;
   }
   return added;
