@@ -23,6 +23,8 @@
 #include "place/vocabulary.h"
 #include "progress_line.h"
 #include "run_options.h"
+#include "segmenter_option.h"
+#include "semantic_evaluation.h"
 #include "util/timing_stats.h"
 #include "vocabulary_option.h"
 
@@ -87,6 +89,8 @@ EdgeEndpoint openEdge(const RunOptions& options, std::shared_ptr<const Vocabular
   std::optional<LinkSettings> link;
   if (options.link != "none") link = linkProfile(options.link);
   SlamSessionOptions session;
+  if (options.semantic)
+    session.segmenter = segmenterOptions(options.models_dir, options.segment_input);
   session.mapping.vocabulary = std::move(vocabulary);
   session.mapping.loop_closing = options.loop_closing;
   edge.embedded = std::make_unique<EmbeddedEdge>(session, link);
@@ -119,7 +123,9 @@ std::unique_ptr<SlamSystem> makeSlamSystem(const RunOptions& options, const std:
     return std::make_unique<OffloadSlam>(sensor,
                                          std::make_unique<EdgeClient>(edge.address, config));
   }
-  auto link = std::make_unique<GrpcEdgeLink>(edge.address, config);
+  EdgeClientOptions client_options;
+  client_options.keyframe_image.downscale = options.segment_reduce;
+  auto link = std::make_unique<GrpcEdgeLink>(edge.address, config, client_options);
   AdaptationLoopOptions adaptation;
   adaptation.adapt = options.adapt;
   adaptation.controller.initial_row = 0;  // the run starts with Table I row 1
@@ -162,6 +168,14 @@ int runPipeline(const RunOptions& options) {
   slam_options.tracker.vocabulary = loadVocabulary(options.vocabulary);
   slam_options.vocabulary = slam_options.tracker.vocabulary;
   slam_options.loop_closing = options.loop_closing;
+  slam_options.semantic = options.semantic;
+  slam_options.keyframe_image_reduce = options.segment_reduce;
+  if (options.semantic) {
+    // Loaded here even in edge mode: a missing model is reported before any frame is read.
+    std::shared_ptr<Segmenter> segmenter =
+        loadSegmenter(segmenterOptions(options.models_dir, options.segment_input));
+    if (mode == "local") slam_options.segmenter = std::move(segmenter);
+  }
   spdlog::info("{} ORB features, {} levels; keyframes fmin {} fmax {} alpha {} beta {}",
                slam_options.orb.num_features, slam_options.orb.num_levels, kf.fmin, kf.fmax,
                kf.alpha, kf.beta);
@@ -177,6 +191,8 @@ int runPipeline(const RunOptions& options) {
   Stopwatch wall;
   Trajectory ground_truth;
   std::size_t tracked = 0, lost = 0;
+  std::optional<SemanticEvaluation> semantic_eval = SemanticEvaluation::open(info.path);
+  if (semantic_eval) spdlog::info("ground-truth masks found: scoring the semantic culling");
   const auto& stamps = reader->timestamps();
   for (std::size_t i = 0; i < frame_count; ++i) {
     if (options.realtime && i > 0) {
@@ -190,8 +206,10 @@ int runPipeline(const RunOptions& options) {
     load_ms.add(load_timer.elapsedMs());
     if (frame.ground_truth) ground_truth.push_back({frame.timestamp, *frame.ground_truth});
     Stopwatch frame_timer;
-    const TrackResult result = slam.process(i, frame.timestamp, frame.gray, frame.depth);
+    const TrackResult result =
+        slam.process(i, frame.timestamp, frame.gray, frame.depth, frame.color);
     const double processing_ms = frame_timer.elapsedMs();
+    if (semantic_eval) semantic_eval->addFrame(i, result, slam.lastSemanticFrame());
     client_ms.add(processing_ms);
     if (options.realtime) {
       const double due_ms = (stamps[i] - stamps[0]) * 1000.0;
@@ -221,7 +239,6 @@ int runPipeline(const RunOptions& options) {
   const auto ate = ateJson(ground_truth, at_time, align);
   const auto ate_final = ateJson(ground_truth, final_traj, align);
 
-  const PercentileSummary zero;
   const SlamCounters counters = slam.counters();
   const std::size_t keyframes_uploaded = std::max<std::size_t>(1, counters.keyframes_uploaded);
   nlohmann::json metrics = {{"frames", frame_count},
@@ -240,7 +257,7 @@ int runPipeline(const RunOptions& options) {
                             {"reconnects", counters.reconnects},
                             {"slice_latency_ms", toJson(counters.slice_latency_ms)},
                             {"slice_apply_ms", toJson(counters.slice_apply_ms)},
-                            {"segmentation_ms", toJson(zero)},
+                            {"segmentation_ms", toJson(counters.segmentation_ms)},
                             {"loops", counters.loops},
                             {"relocalizations", slam.relocalizations()},
                             {"map_resets", slam.mapResets()},
@@ -273,6 +290,16 @@ int runPipeline(const RunOptions& options) {
          std::min<std::uint64_t>(counters.uplink_bytes, c.probe_uplink_bytes)) /
         keyframes_uploaded;
   }
+  if (options.semantic || semantic_eval) {
+    nlohmann::json semantic = {{"enabled", options.semantic},
+                               {"keyframes_segmented", counters.keyframes_segmented},
+                               {"movable_points_erased", counters.movable_points_erased},
+                               {"frames_with_mask", counters.frames_with_mask},
+                               {"features_culled", counters.features_culled},
+                               {"client_ms", toJson(counters.semantic_client_ms)}};
+    if (semantic_eval) semantic.update(semantic_eval->json());
+    metrics["semantic"] = semantic;
+  }
   if (ate) metrics["ate"] = *ate;
   if (ate_final) metrics["ate_final"] = *ate_final;
 
@@ -292,6 +319,14 @@ int runPipeline(const RunOptions& options) {
   }
   fmt::print("  client ms    median {:.2f}  p90 {:.2f}  p99 {:.2f}  max {:.2f}\n", client.median,
              client.p90, client.p99, client.max);
+  if (options.semantic) {
+    fmt::print(
+        "  semantic     {} keyframes segmented ({:.0f} ms median), {} features culled, transfer "
+        "and culling {:.2f} ms median per frame\n",
+        counters.keyframes_segmented, counters.segmentation_ms.median, counters.features_culled,
+        counters.semantic_client_ms.median);
+  }
+  if (semantic_eval) fmt::print("  {}\n", semantic_eval->summaryLine());
   if (ate) {
     fmt::print("  ATE ({})    rmse {:.4f} m  ({} poses, at frame time)\n", toString(align),
                (*ate)["rmse_m"].get<double>(), (*ate)["pairs"].get<std::size_t>());
@@ -332,6 +367,15 @@ void addRunOptions(CLI::App* run, const std::shared_ptr<RunOptions>& options) {
   run->add_option("--semantic", options->semantic, "Semantic culling on|off")
       ->transform(
           CLI::CheckedTransformer(std::map<std::string, bool>{{"on", true}, {"off", false}}));
+  run->add_option("--models", options->models_dir,
+                  "Segmentation models folder for --semantic on (default: the shared models)");
+  run->add_option("--segment-input", options->segment_input,
+                  "Side of the segmentation detector's input (multiple of 32)")
+      ->capture_default_str();
+  run->add_option("--segment-reduce", options->segment_reduce,
+                  "Keyframes are segmented at 1/N of full size (the image sent to the edge)")
+      ->check(CLI::Range(1, 8))
+      ->capture_default_str();
   run->add_option("--max-frames", options->max_frames, "Process at most N frames (0 = all)");
   auto* realtime = run->add_flag("--realtime", options->realtime,
                                  "Feed frames at the dataset's rate, dropping none");

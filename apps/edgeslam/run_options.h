@@ -16,9 +16,12 @@ struct RunOptions {
   std::string server_address;  // `client`: the edge server; empty = embedded on loopback
   bool adapt = true;
   bool semantic = false;
-  std::size_t max_frames = 0;  // 0 = all
-  bool realtime = false;       // feed at the dataset's rate (default: as fast as possible)
-  bool fast = false;           // explicit request for the default
+  std::filesystem::path models_dir;  // segmentation models; "" = the shared models folder
+  int segment_input = 256;           // detector input side
+  int segment_reduce = 2;            // keyframes are segmented at 1/this of full size
+  std::size_t max_frames = 0;        // 0 = all
+  bool realtime = false;             // feed at the dataset's rate (default: as fast as possible)
+  bool fast = false;                 // explicit request for the default
   std::filesystem::path out_dir;
   int viewer_port = 0;
   std::optional<std::filesystem::path> camera_file;

@@ -7,6 +7,7 @@
 #include <memory>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 #include <string>
 #include <vector>
 
@@ -34,6 +35,8 @@ struct SegmentOptions {
   int repeat = 1;
   int mask_downscale = 2;
   int threads = 0;
+  int input_size = 512;
+  int reduce = 1;
 };
 
 bool isImageFile(const fs::path& path) {
@@ -60,8 +63,15 @@ std::vector<fs::path> listImages(const fs::path& folder) {
 
 void segmentOne(Segmenter& segmenter, const fs::path& input, const fs::path& output,
                 const SegmentOptions& o) {
-  const cv::Mat image = cv::imread(input.string(), cv::IMREAD_COLOR);
+  cv::Mat image = cv::imread(input.string(), cv::IMREAD_COLOR);
   if (image.empty()) throw std::runtime_error("cannot read image " + input.string());
+  if (o.reduce > 1) {
+    // As keyframes reach the edge: reduced on the client.
+    cv::resize(
+        image, image,
+        cv::Size((image.cols + o.reduce - 1) / o.reduce, (image.rows + o.reduce - 1) / o.reduce), 0,
+        0, cv::INTER_AREA);
+  }
   Segmentation segmentation;
   SampleStats times;
   for (int i = 0; i < std::max(1, o.repeat); ++i) {
@@ -97,6 +107,7 @@ void runSegment(const SegmentOptions& o) {
   options.classes = parseClassList(o.classes);
   options.nms_threshold = o.nm;
   options.score_threshold = o.score;
+  options.detector_input_size = o.input_size;
   const auto segmenter = makeSegmenter(options);
   fmt::print("segmenter {} (models {}), classes {}, nm {:.2f}, score {:.2f}\n",
              segmenter->backendName(), options.model_dir.string(),
@@ -150,6 +161,15 @@ void addSegmentCommand(CLI::App& app) {
   segment
       ->add_option("--mask-downscale", options->mask_downscale,
                    "Downscale for the reported wire size of the label image")
+      ->check(CLI::Range(1, 16))
+      ->capture_default_str();
+  segment
+      ->add_option("--input-size", options->input_size,
+                   "Side of the detector's square input (multiple of 32; trained at 512)")
+      ->capture_default_str();
+  segment
+      ->add_option("--reduce", options->reduce,
+                   "Shrink each image N times first (keyframes reach the edge at 1/2)")
       ->check(CLI::Range(1, 16))
       ->capture_default_str();
   segment

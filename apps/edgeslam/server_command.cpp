@@ -4,11 +4,13 @@
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <filesystem>
 #include <memory>
 #include <thread>
 
 #include "commands.h"
 #include "pipeline/slam_session_backend.h"
+#include "segmenter_option.h"
 #include "vocabulary_option.h"
 
 namespace edgeslam::cli {
@@ -20,9 +22,33 @@ void requestStop(int) {
   g_stop = true;
 }
 
-int runServer(const std::string& listen, int status_interval_s, const std::string& vocabulary) {
+struct ServerOptions {
+  std::string listen = "0.0.0.0:50051";
+  int status_interval_s = 10;
+  std::string vocabulary;
+  std::string semantic = "auto";
+  std::filesystem::path models_dir;
+  int segment_input = 256;
+};
+
+int runServer(const ServerOptions& o) {
   SlamSessionOptions options;
-  options.mapping.vocabulary = loadVocabulary(vocabulary);
+  options.mapping.vocabulary = loadVocabulary(o.vocabulary);
+  if (o.semantic != "off") {
+    const SegmenterOptions segmenter = segmenterOptions(o.models_dir, o.segment_input);
+    try {
+      loadSegmenter(segmenter);  // fail now rather than at the first session
+      options.segmenter = segmenter;
+      spdlog::info("segmentation models in {}: sessions may ask for semantic culling",
+                   segmenter.model_dir.string());
+    } catch (const std::exception& e) {
+      if (o.semantic == "on") throw;
+      spdlog::warn("no segmentation ({}): sessions asking for semantic culling are refused",
+                   e.what());
+    }
+  }
+  const std::string& listen = o.listen;
+  const int status_interval_s = o.status_interval_s;
   EdgeServer server(listen, std::make_shared<SlamSessionFactory>(options));
   spdlog::info("edge server listening on {} (Ctrl-C to stop)", server.address());
   std::signal(SIGINT, requestStop);
@@ -46,16 +72,23 @@ int runServer(const std::string& listen, int status_interval_s, const std::strin
 }
 
 void addServerCommand(CLI::App& app) {
-  auto listen = std::make_shared<std::string>("0.0.0.0:50051");
-  auto interval = std::make_shared<int>(10);
-  auto vocabulary = std::make_shared<std::string>();
+  auto o = std::make_shared<ServerOptions>();
   auto* cmd = app.add_subcommand("server", "The edge server: global maps for many client sessions");
-  cmd->add_option("--listen", *listen, "HOST:PORT to listen on (port 0 = any free port)");
-  cmd->add_option("--status-every", *interval, "Seconds between session status lines (0 = none)");
-  cmd->add_option("--vocab", *vocabulary,
+  cmd->add_option("--listen", o->listen, "HOST:PORT to listen on (port 0 = any free port)");
+  cmd->add_option("--status-every", o->status_interval_s,
+                  "Seconds between session status lines (0 = none)");
+  cmd->add_option("--vocab", o->vocabulary,
                   "Vocabulary for loop closing (default: vocab/ next to the binary; none = off)");
-  cmd->callback(
-      [listen, interval, vocabulary] { exitCode() = runServer(*listen, *interval, *vocabulary); });
+  cmd->add_option("--semantic", o->semantic,
+                  "Segment keyframes for clients that ask: on (models required), off, auto (when "
+                  "the models load)")
+      ->check(CLI::IsMember({"on", "off", "auto"}));
+  cmd->add_option("--segment-input", o->segment_input,
+                  "Side of the segmentation detector's input (multiple of 32)")
+      ->capture_default_str();
+  cmd->add_option("--models", o->models_dir,
+                  "Segmentation models folder (default: the shared models)");
+  cmd->callback([o] { exitCode() = runServer(*o); });
 }
 
 const CommandRegistration kServerCommandRegistration{15, addServerCommand};

@@ -22,6 +22,7 @@ void EdgeKeyFrameSink::insertKeyFrame(KeyFrame* keyframe) {
     }
     upload.map_reset = reset_pending_;
     reset_pending_ = false;
+    if (!image_.empty() && image_frame_ == keyframe->frameIndex()) upload.raw_image = image_;
   }
   upload.sequence = sequence_.load() + 1;
   {
@@ -31,6 +32,11 @@ void EdgeKeyFrameSink::insertKeyFrame(KeyFrame* keyframe) {
   }
   sequence_ = upload.sequence;
   uplink_.send(std::move(upload));
+}
+
+void EdgeKeyFrameSink::attachImage(std::size_t frame_index, cv::Mat image) {
+  image_frame_ = frame_index;
+  image_ = std::move(image);
 }
 
 bool EdgeKeyFrameSink::acceptsKeyFrames() const {

@@ -28,6 +28,10 @@ class EdgeKeyFrameSink : public KeyFrameSink {
   std::size_t lastOptimizedFrame() const override { return last_optimized_frame_.load(); }
   void onMapReset() override;
 
+  // The image of the frame about to be tracked: if that frame becomes a keyframe, the image goes
+  // up with it (for segmentation on the edge). Call on the tracking thread.
+  void attachImage(std::size_t frame_index, cv::Mat image);
+
   // A slice answering upload `upload_sequence` was applied; returns the seconds since that upload
   // was sent (negative when unknown), for the slice-latency statistics.
   double onSliceApplied(std::uint64_t upload_sequence, std::size_t processed_frame_index);
@@ -46,6 +50,8 @@ class EdgeKeyFrameSink : public KeyFrameSink {
   std::atomic<std::uint64_t> answered_{0};
   std::atomic<std::size_t> last_optimized_frame_{0};
   bool reset_pending_ = false;
+  std::size_t image_frame_ = 0;
+  cv::Mat image_;
   std::unordered_set<MapPointId> uploaded_points_;
   std::mutex sent_mutex_;
   std::deque<std::pair<std::uint64_t, Clock::time_point>> sent_times_;

@@ -45,6 +45,7 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
     if (initialize(frame)) {
       state_ = TrackingState::kOk;
       result.new_keyframe = true;
+      if (reference_keyframe_ != nullptr) result.keyframe = reference_keyframe_->id();
       last_frame_ = frame;
       record(frame, true);
       result.state = state_;
@@ -139,6 +140,7 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
   result.state = state_;
   if (ok) result.T_cw = frame.T_cw;
   result.new_keyframe = new_keyframe != nullptr;
+  if (new_keyframe != nullptr) result.keyframe = new_keyframe->id();
   return result;
 }
 

@@ -4,6 +4,7 @@
 #include <optional>
 
 #include "geometry/se3.h"
+#include "map/ids.h"
 #include "map/keyframe_sink.h"
 #include "map/sensor.h"
 
@@ -17,6 +18,7 @@ struct TrackResult {
   TrackingState state = TrackingState::kNotInitialized;
   std::optional<SE3d> T_cw;  // camera-from-world when tracked
   bool new_keyframe = false;
+  KeyFrameId keyframe = kInvalidId;  // the new keyframe's id
   bool relocalized = false;
   int tracked_points = 0;
 };

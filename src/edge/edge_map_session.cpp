@@ -2,16 +2,23 @@
 
 #include <spdlog/spdlog.h>
 
+#include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 
+#include "edge/movable_points.h"
 #include "edge/slice_builder.h"
 #include "map/map_replication.h"
+#include "semantic/label_encoding.h"
 
 namespace edgeslam {
 
 EdgeMapSession::EdgeMapSession(const PinholeCamera& camera, Sensor sensor,
                                EdgeMapSessionOptions options, Publish publish)
-    : camera_(camera), publish_(std::move(publish)), threaded_(options.threaded) {
+    : camera_(camera),
+      mask_downscale_(std::max(1, options.mask_downscale)),
+      movable_point_erode_px_(options.movable_point_erode_px),
+      publish_(std::move(publish)),
+      threaded_(options.threaded) {
   options.mapper.monocular = sensor == Sensor::kMonocular;
   mapper_ = std::make_unique<LocalMapper>(map_, camera_, options.mapper);
   if (options.vocabulary != nullptr && options.loop_closing) {
@@ -26,6 +33,11 @@ EdgeMapSession::EdgeMapSession(const PinholeCamera& camera, Sensor sensor,
     publishSlice(kf);
     if (loop_closer_) loop_closer_->insertKeyFrame(kf);
   });
+  if (options.segmenter != nullptr) {
+    segmentation_ = std::make_unique<KeyFrameSegmentationWorker>(
+        options.segmenter,
+        [this](KeyFrameSegmentationResult result) { onSegmented(std::move(result)); });
+  }
   if (threaded_) mapper_->start();
 }
 
@@ -34,11 +46,21 @@ EdgeMapSession::~EdgeMapSession() {
 }
 
 void EdgeMapSession::stop() {
+  if (segmentation_) segmentation_->stop();
   if (loop_closer_) loop_closer_->stop();
   mapper_->stop();
 }
 
 void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
+  cv::Mat image;
+  if (segmentation_ != nullptr && !upload.image_bytes.empty()) {
+    image = cv::imdecode(upload.image_bytes, cv::IMREAD_UNCHANGED);
+    if (image.empty() || (image.type() != CV_8UC1 && image.type() != CV_8UC3)) {
+      throw std::invalid_argument("keyframe image (" + upload.image_encoding + ", " +
+                                  std::to_string(upload.image_bytes.size()) +
+                                  " bytes) is not an 8-bit grey or colour image");
+    }
+  }
   KeyFrame* keyframe = nullptr;
   {
     std::lock_guard lock(map_.updateMutex());
@@ -67,6 +89,11 @@ void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
     upload_of_keyframe_[keyframe->id()] = upload.sequence;
     newest_keyframe_ = keyframe->id();
   }
+  if (!image.empty()) {
+    segmentation_->submit({keyframe->id(), keyframe->frameIndex(), std::move(image),
+                           cv::Size(camera_.width(), camera_.height())});
+    if (!threaded_) segmentation_->waitUntilIdle();
+  }
   mapper_->insertKeyFrame(keyframe);
   if (!threaded_) {
     mapper_->processAll();
@@ -80,8 +107,16 @@ void EdgeMapSession::publishSlice(KeyFrame* mapped) {
   {
     std::lock_guard lock(map_.updateMutex());
     const std::size_t loops = loop_closer_ ? loop_closer_->loops() : 0;
-    if (mapped == nullptr && map_.changes().empty() && loops == loops_published_) return;
+    std::vector<MaskRecord> masks;
+    {
+      std::lock_guard state(state_mutex_);
+      masks.swap(pending_masks_);
+    }
+    if (mapped == nullptr && map_.changes().empty() && loops == loops_published_ && masks.empty()) {
+      return;
+    }
     slice = buildSlice(map_, map_.takeChanges());
+    slice.masks = std::move(masks);
     if (mapped != nullptr) {
       slice.processed_keyframe = mapped->id();
       if (!mapped->isBad()) {
@@ -111,7 +146,35 @@ void EdgeMapSession::publishSlice(KeyFrame* mapped) {
   if (publish_) publish_(std::move(slice));
 }
 
+void EdgeMapSession::onSegmented(KeyFrameSegmentationResult result) {
+  MaskRecord mask;
+  mask.keyframe = result.keyframe;
+  mask.bytes = encodeLabelImage(result.labels, mask_downscale_, mask.encoding);
+  mask.width = (result.labels.cols + mask_downscale_ - 1) / mask_downscale_;
+  mask.height = (result.labels.rows + mask_downscale_ - 1) / mask_downscale_;
+  mask.segmentation_ms = result.segmentation_ms;
+  std::size_t erased = 0;
+  {
+    std::lock_guard lock(map_.updateMutex());
+    KeyFrame* keyframe = map_.keyFrame(result.keyframe);
+    // A keyframe culled meanwhile: the mask still helps the client's transfer.
+    if (keyframe != nullptr) {
+      erased = eraseMovablePoints(map_, *keyframe, result.labels, movable_point_erode_px_);
+    }
+    std::lock_guard state(state_mutex_);
+    ++stats_.keyframes_segmented;
+    stats_.movable_points_erased += erased;
+    pending_masks_.push_back(std::move(mask));
+  }
+  publishSlice(nullptr);
+}
+
+void EdgeMapSession::setNmsThreshold(float nm) {
+  if (segmentation_) segmentation_->setNmsThreshold(nm);
+}
+
 void EdgeMapSession::finish() {
+  if (segmentation_) segmentation_->waitUntilIdle();
   mapper_->waitUntilIdle();
   if (loop_closer_) loop_closer_->waitUntilIdle();
 }

@@ -9,6 +9,7 @@
 #include <mutex>
 #include <unordered_map>
 
+#include "edge/keyframe_segmentation.h"
 #include "edge/local_mapper.h"
 #include "edge/loop_closer.h"
 #include "geometry/camera.h"
@@ -23,6 +24,11 @@ struct EdgeMapSessionOptions {
   bool threaded = true;  // false: map each keyframe inside onKeyFrame (deterministic tests)
   std::shared_ptr<const Vocabulary> vocabulary;
   bool loop_closing = true;  // with a vocabulary
+  // Semantic culling: keyframes uploaded with an image are segmented on a thread of their own by
+  // this segmenter (one per session); nullptr = no segmentation.
+  std::shared_ptr<Segmenter> segmenter;
+  int mask_downscale = 4;  // the label image travels at 1/this of the camera's resolution
+  int movable_point_erode_px = 2;
 };
 
 struct EdgeMapSessionStats {
@@ -30,6 +36,8 @@ struct EdgeMapSessionStats {
   std::uint64_t slices = 0;
   std::uint64_t keyframes = 0;
   std::uint64_t map_points = 0;
+  std::uint64_t keyframes_segmented = 0;
+  std::uint64_t movable_points_erased = 0;
 };
 
 class EdgeMapSession {
@@ -53,15 +61,23 @@ class EdgeMapSession {
   Map& map() { return map_; }
   // nullptr without a vocabulary or with loop closing off.
   const LoopCloser* loopCloser() const { return loop_closer_.get(); }
+  // nullptr without segmentation.
+  const KeyFrameSegmentationWorker* segmentation() const { return segmentation_.get(); }
+  // Box NMS threshold of the segmenter (paper Table I's nm), from the next keyframe on.
+  void setNmsThreshold(float nm);
 
  private:
   // `mapped`: the keyframe just mapped, or nullptr for a loop correction or global BA.
   void publishSlice(KeyFrame* mapped);
+  void onSegmented(KeyFrameSegmentationResult result);
 
   PinholeCamera camera_;
   Map map_;
   std::unique_ptr<LocalMapper> mapper_;
   std::unique_ptr<LoopCloser> loop_closer_;
+  std::unique_ptr<KeyFrameSegmentationWorker> segmentation_;
+  int mask_downscale_;
+  int movable_point_erode_px_;
   Publish publish_;
   bool threaded_;
 
@@ -73,6 +89,7 @@ class EdgeMapSession {
   KeyFrameId newest_keyframe_ = kInvalidId;
   EdgeMapSessionStats stats_;
   std::size_t loops_published_ = 0;
+  std::vector<MaskRecord> pending_masks_;
 };
 
 }  // namespace edgeslam

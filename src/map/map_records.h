@@ -63,6 +63,9 @@ struct KeyFrameUpload {
   std::vector<MapPointRecord> new_points;
   std::string image_encoding;  // "" (none), "jpeg", "png"
   std::vector<std::uint8_t> image_bytes;
+  // Not on the wire: the keyframe's image, encoded into image_bytes on the link's thread so that
+  // tracking does not pay for the compression.
+  cv::Mat raw_image;
   std::uint64_t acknowledged_slice = 0;  // last slice the client applied
 };
 
@@ -83,8 +86,9 @@ struct MaskRecord {
   KeyFrameId keyframe = kInvalidId;
   int width = 0;  // of the encoded label image
   int height = 0;
-  std::string encoding;  // "png" or "rle"
+  std::string encoding;  // "png/N" (reduced N times) or "empty" (see semantic/label_encoding.h)
   std::vector<std::uint8_t> bytes;
+  double segmentation_ms = 0.0;  // the edge's time to segment the keyframe
 };
 
 // Edge -> client: what changed in the global map since the last slice the client acknowledged.

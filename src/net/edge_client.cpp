@@ -214,8 +214,9 @@ struct EdgeClient::Impl {
       }
       v1::UploadKeyFrameRequest request;
       try {
+        compressKeyFrameImage(upload, options.keyframe_image);
         toProto(upload, request.mutable_upload(), encode_options);
-      } catch (const WireError& e) {
+      } catch (const std::exception& e) {
         spdlog::error("edge client: upload {} cannot be encoded: {}", upload.sequence, e.what());
         finishUpload(false, true);
         continue;

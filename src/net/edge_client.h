@@ -13,6 +13,7 @@
 
 #include "map/map_records.h"
 #include "net/wire_types.h"
+#include "semantic/keyframe_image.h"
 
 namespace edgeslam {
 
@@ -43,6 +44,8 @@ struct EdgeClientOptions {
   std::chrono::milliseconds backoff_max{2000};
   std::size_t max_receive_message_bytes = 64u << 20;
   bool send_keypoint_response = false;
+  // How a keyframe's image (when the upload carries one) is compressed before it is sent.
+  KeyFrameImageOptions keyframe_image;
   // Called on the slice reader thread, in sequence order, one slice at a time. Leave empty for a
   // client that does not stream slices (probing, offload mode).
   std::function<void(MapSlice)> on_slice;

@@ -1,6 +1,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <string_view>
 #include <unordered_set>
@@ -409,10 +410,21 @@ MaskRecord fromProto(const v1::Mask& in) {
     if (in.width() < 1 || in.height() < 1 || in.width() > max_side || in.height() > max_side) {
       throw WireError(fmt::format("size {} x {} outside 1..{}", in.width(), in.height(), max_side));
     }
-    if (in.encoding() != "png" && in.encoding() != "rle") {
-      throw WireError(fmt::format("encoding '{}' is neither png nor rle", in.encoding()));
+    const std::string& encoding = in.encoding();
+    const bool empty = encoding == "empty";
+    int reduction = 0;
+    if (!empty && (encoding.rfind("png/", 0) != 0 ||
+                   std::sscanf(encoding.c_str() + 4, "%d", &reduction) != 1 || reduction < 1 ||
+                   reduction > 64 || encoding != "png/" + std::to_string(reduction))) {
+      throw WireError(fmt::format("encoding '{}' is neither png/N (N 1..64) nor empty", encoding));
     }
-    if (in.data().empty()) throw WireError("no data");
+    if (empty != in.data().empty()) {
+      throw WireError(fmt::format("encoding '{}' with {} data bytes", encoding, in.data().size()));
+    }
+    if (!std::isfinite(in.segmentation_ms()) || in.segmentation_ms() < 0.f) {
+      throw WireError(fmt::format("segmentation time {} ms", in.segmentation_ms()));
+    }
+    out.segmentation_ms = in.segmentation_ms();
     out.width = static_cast<int>(in.width());
     out.height = static_cast<int>(in.height());
     out.encoding = in.encoding();

@@ -329,6 +329,7 @@ void toProto(const MaskRecord& mask, v1::Mask* out) {
   out->set_height(static_cast<std::uint32_t>(std::max(mask.height, 0)));
   out->set_encoding(mask.encoding);
   out->set_data(mask.bytes.data(), mask.bytes.size());
+  out->set_segmentation_ms(static_cast<float>(mask.segmentation_ms));
 }
 
 void toProto(const MapSlice& slice, v1::MapSlice* out, const WireEncodeOptions& options) {

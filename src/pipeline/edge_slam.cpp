@@ -7,6 +7,7 @@
 #include <thread>
 
 #include "client/slice_applier.h"
+#include "semantic/label_encoding.h"
 
 namespace edgeslam {
 
@@ -25,6 +26,10 @@ EdgeSlam::EdgeSlam(const PinholeCamera& camera, SlamOptions options, std::unique
 EdgeSlam::~EdgeSlam() {
   if (adaptation_) adaptation_->stop();  // it probes through the link's client
   link_->close();
+}
+
+void EdgeSlam::beforeTracking(std::size_t frame_index, const cv::Mat& image) {
+  if (semantic_filter_) sink_->attachImage(frame_index, image);
 }
 
 void EdgeSlam::afterFrame() {
@@ -68,11 +73,35 @@ void EdgeSlam::onSlice(MapSlice slice) {
       slice.sequence, applied.frame_index, applied.points_upserted, applied.points_erased,
       applied.keyframes_moved, apply_ms);
   const double latency_s = sink_->onSliceApplied(slice.upload_sequence, applied.frame_index);
+  for (const MaskRecord& mask : slice.masks) offerMask(mask);
   std::lock_guard lock(stats_mutex_);
   ++slices_applied_;
   loops_ += slice.loops_closed;
   slice_apply_ms_.add(apply_ms);
   if (latency_s >= 0.0) slice_latency_ms_.add(latency_s * 1000.0);
+}
+
+void EdgeSlam::offerMask(const MaskRecord& mask) {
+  {
+    std::lock_guard lock(stats_mutex_);
+    ++keyframes_segmented_;
+    segmentation_ms_.add(mask.segmentation_ms);
+  }
+  if (!semantic_filter_) return;
+  std::size_t frame_index = 0;
+  {
+    std::lock_guard lock(map_.updateMutex());
+    const KeyFrame* keyframe = map_.keyFrame(mask.keyframe);
+    if (keyframe == nullptr) return;  // culled meanwhile: its mask is of no use any more
+    frame_index = keyframe->frameIndex();
+  }
+  try {
+    semantic_filter_->offerMask(
+        frame_index,
+        decodeLabelImage(mask.bytes, mask.encoding, cv::Size(camera_.width(), camera_.height())));
+  } catch (const std::exception& e) {
+    spdlog::warn("mask of the keyframe of frame {} ignored: {}", frame_index, e.what());
+  }
 }
 
 void EdgeSlam::finish() {
@@ -101,6 +130,9 @@ SlamCounters EdgeSlam::counters() const {
   out.loops = loops_;
   out.slice_latency_ms = slice_latency_ms_.summary();
   out.slice_apply_ms = slice_apply_ms_.summary();
+  out.keyframes_segmented = keyframes_segmented_;
+  out.segmentation_ms = segmentation_ms_.summary();
+  addSemanticCounters(out);
   return out;
 }
 

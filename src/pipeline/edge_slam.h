@@ -32,7 +32,9 @@ class EdgeSlam : public TrackingSlam {
 
  private:
   void onSlice(MapSlice slice);
+  void offerMask(const MaskRecord& mask);
   void afterFrame() override;
+  void beforeTracking(std::size_t frame_index, const cv::Mat& image) override;
   void applyConfiguration(const KeyframeConfig& config);
 
   std::unique_ptr<EdgeLink> link_;
@@ -45,6 +47,8 @@ class EdgeSlam : public TrackingSlam {
   SampleStats slice_apply_ms_;
   std::uint64_t slices_applied_ = 0;
   std::uint64_t loops_ = 0;
+  std::uint64_t keyframes_segmented_ = 0;
+  SampleStats segmentation_ms_;
 };
 
 }  // namespace edgeslam

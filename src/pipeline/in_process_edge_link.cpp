@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include "semantic/keyframe_image.h"
+
 namespace edgeslam {
 
 InProcessEdgeLink::InProcessEdgeLink(const PinholeCamera& camera, Sensor sensor,
@@ -36,6 +38,7 @@ void InProcessEdgeLink::run() {
       busy_ = true;
     }
     try {
+      compressKeyFrameImage(upload);
       session_->onKeyFrame(upload);
     } catch (const std::exception& e) {
       spdlog::error("edge session rejected keyframe upload {}: {}", upload.sequence, e.what());

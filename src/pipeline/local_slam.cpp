@@ -1,5 +1,9 @@
 #include "pipeline/local_slam.h"
 
+#include <stdexcept>
+
+#include "edge/movable_points.h"
+
 namespace edgeslam {
 
 LocalSlam::LocalSlam(const PinholeCamera& camera, SlamOptions options)
@@ -16,13 +20,41 @@ LocalSlam::LocalSlam(const PinholeCamera& camera, SlamOptions options)
     mapper_->setKeyFrameMappedCallback([this](KeyFrame* kf) { loop_closer_->insertKeyFrame(kf); });
     loop_closer_->start();
   }
+  if (options_.semantic) {
+    if (options_.segmenter == nullptr) {
+      throw std::invalid_argument("semantic culling in local mode needs a segmenter");
+    }
+    segmentation_ = std::make_unique<KeyFrameSegmentationWorker>(
+        options_.segmenter,
+        [this](KeyFrameSegmentationResult result) { onSegmented(std::move(result)); });
+  }
   startTracking(mapper_.get());
   if (options_.threaded_mapping) mapper_->start();
 }
 
 LocalSlam::~LocalSlam() {
+  if (segmentation_) segmentation_->stop();
   if (loop_closer_) loop_closer_->stop();
   mapper_->stop();
+}
+
+void LocalSlam::afterTracking(const TrackResult& result, std::size_t frame_index,
+                              const cv::Mat& image) {
+  if (!segmentation_ || !result.new_keyframe || result.keyframe == kInvalidId) return;
+  segmentation_->submit({result.keyframe, frame_index, image.clone(),
+                         cv::Size(camera_.width(), camera_.height()),
+                         options_.keyframe_image_reduce});
+  if (!options_.threaded_mapping) segmentation_->waitUntilIdle();
+}
+
+void LocalSlam::onSegmented(KeyFrameSegmentationResult result) {
+  {
+    std::lock_guard lock(map_.updateMutex());
+    if (KeyFrame* keyframe = map_.keyFrame(result.keyframe)) {
+      movable_points_erased_ += eraseMovablePoints(map_, *keyframe, result.labels);
+    }
+  }
+  semantic_filter_->offerMask(result.frame_index, std::move(result.labels));
 }
 
 void LocalSlam::afterFrame() {
@@ -33,6 +65,7 @@ void LocalSlam::afterFrame() {
 }
 
 void LocalSlam::finish() {
+  if (segmentation_) segmentation_->waitUntilIdle();
   mapper_->waitUntilIdle();
   if (loop_closer_) loop_closer_->waitUntilIdle();
 }
@@ -40,6 +73,13 @@ void LocalSlam::finish() {
 SlamCounters LocalSlam::counters() const {
   SlamCounters out;
   if (loop_closer_) out.loops = loop_closer_->loops();
+  addSemanticCounters(out);
+  if (segmentation_) {
+    const KeyFrameSegmentationCounters c = segmentation_->counters();
+    out.keyframes_segmented = c.segmented;
+    out.segmentation_ms = c.segmentation_ms;
+    out.movable_points_erased = movable_points_erased_.load();
+  }
   return out;
 }
 

@@ -1,9 +1,11 @@
 #pragma once
 // The whole SLAM in one process (`--mode local`, the ORB-SLAM baseline): tracking on the caller's
 // thread, local mapping on its own thread, loop closing on another (with a vocabulary), one
-// shared map.
+// shared map; with semantic culling, keyframes are segmented on a thread of their own too.
+#include <atomic>
 #include <memory>
 
+#include "edge/keyframe_segmentation.h"
 #include "edge/local_mapper.h"
 #include "edge/loop_closer.h"
 #include "pipeline/slam_system.h"
@@ -24,9 +26,14 @@ class LocalSlam : public TrackingSlam {
 
  private:
   void afterFrame() override;
+  void afterTracking(const TrackResult& result, std::size_t frame_index,
+                     const cv::Mat& image) override;
+  void onSegmented(KeyFrameSegmentationResult result);
 
   std::unique_ptr<LocalMapper> mapper_;
   std::unique_ptr<LoopCloser> loop_closer_;
+  std::unique_ptr<KeyFrameSegmentationWorker> segmentation_;
+  std::atomic<std::uint64_t> movable_points_erased_{0};
 };
 
 }  // namespace edgeslam

@@ -15,7 +15,7 @@ OffloadSlam::~OffloadSlam() {
 }
 
 TrackResult OffloadSlam::process(std::size_t frame_index, double timestamp, const cv::Mat& gray,
-                                 const cv::Mat& depth) {
+                                 const cv::Mat& depth, const cv::Mat& /*color*/) {
   OffloadFrame frame;
   frame.frame_index = frame_index;
   frame.timestamp = timestamp;

@@ -19,7 +19,7 @@ class OffloadSlam : public SlamSystem {
   ~OffloadSlam() override;
 
   TrackResult process(std::size_t frame_index, double timestamp, const cv::Mat& gray,
-                      const cv::Mat& depth) override;
+                      const cv::Mat& depth, const cv::Mat& color = cv::Mat()) override;
   void finish() override {}
   SlamCounters counters() const override;
   const char* modeName() const override { return "offload"; }

@@ -34,7 +34,16 @@ OffloadTrackingState toOffloadState(TrackingState state) {
 
 SlamSessionBackend::SlamSessionBackend(const SessionConfig& config, SliceSink& sink,
                                        SlamSessionOptions options)
-    : config_(config), sink_(sink), options_(options) {}
+    : config_(config), sink_(sink), options_(options) {
+  if (config_.settings.semantic && options_.segmenter) {
+    try {
+      segmenter_ = makeSegmenter(*options_.segmenter);
+    } catch (const std::runtime_error& e) {
+      // A missing or broken model is the server's problem, but the session cannot be opened.
+      throw std::invalid_argument(std::string("no segmenter for this session: ") + e.what());
+    }
+  }
+}
 
 SlamSessionBackend::~SlamSessionBackend() {
   if (mapping_) mapping_->stop();
@@ -44,6 +53,7 @@ void SlamSessionBackend::onKeyFrame(KeyFrameUpload upload) {
   if (!mapping_) {
     EdgeMapSessionOptions mapping = options_.mapping;
     mapping.mapper.observe_recent_points = true;
+    mapping.segmenter = segmenter_;
     mapping_ = std::make_unique<EdgeMapSession>(
         config_.camera, config_.sensor, mapping, [this](MapSlice slice) {
           try {
@@ -71,6 +81,8 @@ std::optional<OffloadResult> SlamSessionBackend::onFrame(OffloadFrame frame) {
     slam_options.orb.num_features = config_.settings.features;
     slam_options.orb.num_levels = config_.settings.pyramid_levels;
     slam_options.orb.scale_factor = config_.settings.scale_factor;
+    slam_options.semantic = segmenter_ != nullptr;
+    slam_options.segmenter = segmenter_;
     offload_ = std::make_unique<LocalSlam>(config_.camera, slam_options);
   }
   const TrackResult tracked = offload_->process(frame.frame_index, frame.timestamp, gray, depth);
@@ -86,6 +98,11 @@ std::unique_ptr<EdgeSessionBackend> SlamSessionFactory::open(const SessionConfig
                                                              SliceSink& sink) {
   if (config.sensor == Sensor::kStereo) {
     throw std::invalid_argument("stereo sessions are not supported yet");
+  }
+  if (config.settings.semantic && !options_.segmenter) {
+    throw std::invalid_argument(
+        "the client asks for semantic culling and this edge server has no segmenter (start it "
+        "with --semantic on and the models)");
   }
   spdlog::info("edge: session {} for '{}' ({}x{}, {})", config.session_id, config.client_name,
                config.camera.width(), config.camera.height(), toString(config.sensor));

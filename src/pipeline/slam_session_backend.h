@@ -3,6 +3,7 @@
 // uploads in, map slices out); in offload mode it runs the whole SLAM on the frames it is sent.
 #include <memory>
 #include <mutex>
+#include <optional>
 
 #include "edge/edge_map_session.h"
 #include "net/edge_server.h"
@@ -12,6 +13,9 @@ namespace edgeslam {
 
 struct SlamSessionOptions {
   EdgeMapSessionOptions mapping;
+  // Sessions that ask for semantic culling get a segmenter made with these; without, such a
+  // session is refused.
+  std::optional<SegmenterOptions> segmenter;
 };
 
 class SlamSessionBackend : public EdgeSessionBackend {
@@ -26,6 +30,7 @@ class SlamSessionBackend : public EdgeSessionBackend {
   SessionConfig config_;
   SliceSink& sink_;
   SlamSessionOptions options_;
+  std::shared_ptr<Segmenter> segmenter_;     // when the session asked for semantic culling
   std::unique_ptr<EdgeMapSession> mapping_;  // edge mode, made at the first keyframe
   std::unique_ptr<SlamSystem> offload_;      // offload mode, made at the first frame
 };

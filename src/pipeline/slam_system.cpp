@@ -31,6 +31,9 @@ TrackingSlam::TrackingSlam(const PinholeCamera& camera, SlamOptions options,
     : camera_(camera), options_(std::move(options)), extractor_(options_.orb), map_(map_id_origin) {
   options_.tracker.sensor = options_.sensor;
   options_.mapper.monocular = options_.sensor == Sensor::kMonocular;
+  if (options_.semantic) {
+    semantic_filter_ = std::make_unique<SemanticFrameFilter>(camera_, options_.semantic_filter);
+  }
 }
 
 void TrackingSlam::startTracking(KeyFrameSink* sink) {
@@ -38,12 +41,31 @@ void TrackingSlam::startTracking(KeyFrameSink* sink) {
 }
 
 TrackResult TrackingSlam::process(std::size_t frame_index, double timestamp, const cv::Mat& gray,
-                                  const cv::Mat& depth) {
+                                  const cv::Mat& depth, const cv::Mat& color) {
   const cv::Mat& used_depth = options_.sensor == Sensor::kMonocular ? cv::Mat() : depth;
-  auto features = buildFrameFeatures(gray, used_depth, camera_, extractor_, options_.depth);
+  std::shared_ptr<const FrameFeatures> features =
+      buildFrameFeatures(gray, used_depth, camera_, extractor_, options_.depth);
+  if (semantic_filter_) {
+    last_semantic_ = semantic_filter_->filter(frame_index, std::move(features));
+    semantic_ms_.add(last_semantic_.elapsed_ms);
+    features = last_semantic_.kept;
+  } else {
+    last_semantic_ = SemanticFrame{features, features, {}, std::nullopt, 0, 0.0};
+  }
+  const cv::Mat& image = color.empty() ? gray : color;
+  beforeTracking(frame_index, image);
   TrackResult result = tracker_->track(frame_index, timestamp, std::move(features));
+  afterTracking(result, frame_index, image);
   afterFrame();
   return result;
+}
+
+void TrackingSlam::addSemanticCounters(SlamCounters& counters) const {
+  if (!semantic_filter_) return;
+  const SemanticFilterCounters c = semantic_filter_->counters();
+  counters.semantic_client_ms = semantic_ms_.summary();
+  counters.frames_with_mask = c.frames_with_mask;
+  counters.features_culled = c.features_culled;
 }
 
 Trajectory TrackingSlam::trajectoryAtFrameTime() const {

@@ -6,6 +6,7 @@
 #include <memory>
 #include <opencv2/core.hpp>
 
+#include "client/semantic_frame_filter.h"
 #include "client/tracker.h"
 #include "edge/local_mapper.h"
 #include "edge/loop_closer.h"
@@ -14,6 +15,7 @@
 #include "io/trajectory.h"
 #include "map/map.h"
 #include "place/vocabulary.h"
+#include "semantic/segmenter.h"
 #include "util/timing_stats.h"
 
 namespace edgeslam {
@@ -31,6 +33,14 @@ struct SlamOptions {
   bool loop_closing = true;
   // Scale fixing follows `sensor` and threading `threaded_mapping`; the rest is used as is.
   LoopCloserOptions loop_closer;
+  // Semantic culling (paper Sec. IV-C): keyframes are segmented (local mode: by `segmenter`, on a
+  // thread of its own; edge mode: on the edge, from the image sent with the upload) and each
+  // frame's features on the movable objects, found by transferring the latest keyframe mask, are
+  // culled before tracking.
+  bool semantic = false;
+  SemanticFilterOptions semantic_filter;
+  std::shared_ptr<Segmenter> segmenter;  // local mode
+  int keyframe_image_reduce = 2;         // keyframes are segmented at 1/this of full size
 };
 
 // Sensible defaults for a camera: 1000 features up to 640x480-ish, 2000 for wide images (KITTI).
@@ -48,6 +58,13 @@ struct SlamCounters {
   PercentileSummary slice_latency_ms;
   PercentileSummary slice_apply_ms;
   PercentileSummary edge_frame_ms;  // offload: the edge's time per frame
+  // Semantic culling.
+  std::uint64_t keyframes_segmented = 0;
+  std::uint64_t movable_points_erased = 0;  // local mode (the edge erases its own)
+  PercentileSummary segmentation_ms;        // per keyframe, where it ran
+  PercentileSummary semantic_client_ms;     // mask transfer and culling per frame
+  std::uint64_t frames_with_mask = 0;
+  std::uint64_t features_culled = 0;
 };
 
 // One run mode's whole SLAM as the run command drives it.
@@ -55,9 +72,11 @@ class SlamSystem {
  public:
   virtual ~SlamSystem() = default;
 
-  // `depth` is CV_32FC1 metres (RGB-D) or empty.
+  // `depth` is CV_32FC1 metres (RGB-D) or empty; `color` (BGR, optional) is what keyframes are
+  // segmented on when semantic culling is on (else `gray`).
+  // (Overrides repeat the default.)
   virtual TrackResult process(std::size_t frame_index, double timestamp, const cv::Mat& gray,
-                              const cv::Mat& depth) = 0;
+                              const cv::Mat& depth, const cv::Mat& color = cv::Mat()) = 0;
   // Lets mapping finish its backlog (call before reading the final trajectory).
   virtual void finish() = 0;
   virtual SlamCounters counters() const { return {}; }
@@ -72,6 +91,9 @@ class SlamSystem {
   virtual std::size_t mapPointCount() const = 0;
   virtual std::size_t relocalizations() const = 0;
   virtual std::size_t mapResets() const = 0;
+  // The last frame's semantic stage (mask, culled features); nullptr where the client does not
+  // track (offload).
+  virtual const SemanticFrame* lastSemanticFrame() const { return nullptr; }
 };
 
 // Modes that track on the client against the client's map: feature extraction and tracking on the
@@ -82,7 +104,7 @@ class TrackingSlam : public SlamSystem {
   TrackingSlam& operator=(const TrackingSlam&) = delete;
 
   TrackResult process(std::size_t frame_index, double timestamp, const cv::Mat& gray,
-                      const cv::Mat& depth) override;
+                      const cv::Mat& depth, const cv::Mat& color = cv::Mat()) override;
   Trajectory trajectoryAtFrameTime() const override;
   Trajectory trajectoryFinal() const override;
   Trajectory keyframeTrajectory() const override;
@@ -90,6 +112,8 @@ class TrackingSlam : public SlamSystem {
   std::size_t mapPointCount() const override;
   std::size_t relocalizations() const override { return tracker_->relocalizations(); }
   std::size_t mapResets() const override { return tracker_->resets(); }
+  // Always present: without semantic culling, every feature is kept and there is no mask.
+  const SemanticFrame* lastSemanticFrame() const override { return &last_semantic_; }
 
   const Tracker& tracker() const { return *tracker_; }
   // The client's map (lock its update mutex while reading it during a run).
@@ -98,13 +122,24 @@ class TrackingSlam : public SlamSystem {
  protected:
   TrackingSlam(const PinholeCamera& camera, SlamOptions options, std::uint8_t map_id_origin);
   void startTracking(KeyFrameSink* sink);
+  // Before tracking a frame whose image is `image` (colour when given, else grey).
+  virtual void beforeTracking(std::size_t /*frame_index*/, const cv::Mat& /*image*/) {}
   virtual void afterFrame() {}
+  virtual void afterTracking(const TrackResult& /*result*/, std::size_t /*frame_index*/,
+                             const cv::Mat& /*image*/) {}
+  // The semantic stage's figures, for the subclasses' counters().
+  void addSemanticCounters(SlamCounters& counters) const;
 
   PinholeCamera camera_;
   SlamOptions options_;
   OrbExtractor extractor_;
   Map map_;
   std::unique_ptr<Tracker> tracker_;
+  std::unique_ptr<SemanticFrameFilter> semantic_filter_;  // with semantic culling
+
+ private:
+  SemanticFrame last_semantic_;
+  SampleStats semantic_ms_;
 };
 
 }  // namespace edgeslam

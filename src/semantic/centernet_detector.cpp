@@ -13,7 +13,7 @@
 namespace edgeslam {
 namespace {
 
-// The image scaled to fit kInputSize x kInputSize, centred on black: input = image * scale +
+// The image scaled to fit input_size x input_size, centred on black: input = image * scale +
 // offset.
 struct Letterbox {
   cv::Mat image;
@@ -55,7 +55,11 @@ CenterNetDetector::CenterNetDetector(const std::filesystem::path& model_file)
 std::vector<Detection> CenterNetDetector::detect(const cv::Mat& image,
                                                  const CenterNetOptions& options) {
   const cv::Mat bgr = toBgr8(image);
-  const Letterbox box_input = letterbox(bgr, kInputSize);
+  if (options.input_size < 64 || options.input_size % 32 != 0) {
+    throw std::invalid_argument("CenterNet input size must be a multiple of 32 from 64, got " +
+                                std::to_string(options.input_size));
+  }
+  const Letterbox box_input = letterbox(bgr, options.input_size);
   // Raw 0-255 RGB, NCHW.
   const cv::Mat blob = cv::dnn::blobFromImage(box_input.image, 1.0, cv::Size(), cv::Scalar(),
                                               /*swapRB=*/true, /*crop=*/false, CV_32F);
@@ -63,7 +67,7 @@ std::vector<Detection> CenterNetDetector::detect(const cv::Mat& image,
   std::vector<cv::Mat> outputs;
   net_.forward(outputs, output_names_);
 
-  const int grid = kInputSize / kStride;
+  const int grid = options.input_size / kStride;
   const cv::Mat* heat = nullptr;
   const cv::Mat* distances = nullptr;
   for (const cv::Mat& output : outputs) {

@@ -19,6 +19,9 @@ struct CenterNetOptions {
   float score_threshold = 0.3f;
   float nms_threshold = 0.8f;
   std::vector<int> classes;  // keep only these COCO ids; empty = all 80
+  // Side of the square network input, a multiple of 32 (the network is fully convolutional; it
+  // was trained at 512). Smaller is faster and still finds people that fill a good part of it.
+  int input_size = 512;
 };
 
 class CenterNetDetector {
@@ -28,7 +31,7 @@ class CenterNetDetector {
 
   std::vector<Detection> detect(const cv::Mat& bgr, const CenterNetOptions& options);
 
-  static constexpr int kInputSize = 512;
+  static constexpr int kDefaultInputSize = 512;
   static constexpr int kStride = 4;
 
  private:

@@ -46,6 +46,11 @@ CenterNetSelfieSegmenter::CenterNetSelfieSegmenter(const SegmenterOptions& optio
   setNmsThreshold(options.nms_threshold);
   setScoreThreshold(options.score_threshold);
   detector_options_.classes = options.classes.empty() ? defaultMovableClasses() : options.classes;
+  if (options.detector_input_size < 64 || options.detector_input_size % 32 != 0) {
+    throw std::invalid_argument("detector input size must be a multiple of 32 from 64, got " +
+                                std::to_string(options.detector_input_size));
+  }
+  detector_options_.input_size = options.detector_input_size;
   for (int id : detector_options_.classes) cocoClassName(id);  // throws for a bad id
 }
 

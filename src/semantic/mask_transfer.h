@@ -26,7 +26,7 @@ struct MaskTransferOptions {
   int min_matches_for_warp = 6;  // fewer: median translation instead of a similarity
   double ransac_threshold_px = 3.0;
   double min_inlier_ratio = 0.5;  // of the matches used for the similarity
-  double max_scale_change = 1.5;  // similarities scaling by more (or less than 1/this) are rejected
+  double max_scale_change = 2.5;  // similarities scaling by more (or less than 1/this) are rejected
   int ransac_iterations = 200;
   int merge_gap_px = 4;  // transferMask: mask fragments closer than this move as one instance
 };

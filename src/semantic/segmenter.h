@@ -28,6 +28,10 @@ struct SegmenterOptions {
   float mask_threshold = 0.5f;     // person probability above which a pixel is in the mask
   float min_mask_coverage = 0.2f;  // person masks covering less of their box fall back to the box
   float crop_padding = 0.15f;      // context added around a person box before masking, per side
+  // Side of the detector's square input (multiple of 32). The network was trained at 512;
+  // keyframes arrive at half resolution (320x240 for VGA), where 320 loses little and costs
+  // 40 % of 512.
+  int detector_input_size = 512;
 };
 
 class Segmenter {

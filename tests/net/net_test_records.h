@@ -105,7 +105,7 @@ inline MapSlice sampleSlice(std::uint64_t sequence, std::mt19937& rng) {
   s.keyframes_erased = {clientId(3, 2)};
   s.reference_keyframe = clientId(3, 8);
   s.reference_pose = samplePose(rng);
-  s.masks.push_back({clientId(3, 8), 160, 120, "png", {0x89, 'P', 'N', 'G', 9}});
+  s.masks.push_back({clientId(3, 8), 160, 120, "png/4", {0x89, 'P', 'N', 'G', 9}, 131.5});
   s.loops_closed = 2;
   return s;
 }

@@ -319,6 +319,7 @@ TEST(WireConvert, SliceRoundTrip) {
     EXPECT_EQ(back.masks[0].height, s.masks[0].height);
     EXPECT_EQ(back.masks[0].encoding, s.masks[0].encoding);
     EXPECT_EQ(back.masks[0].bytes, s.masks[0].bytes);
+    EXPECT_FLOAT_EQ(static_cast<float>(back.masks[0].segmentation_ms), 131.5f);
     EXPECT_EQ(back.loops_closed, s.loops_closed);
   }
   MapSlice empty;

@@ -230,7 +230,15 @@ TEST(WireValidation, UploadAndSliceEnvelopes) {
   toProto(test::sampleSlice(4, rng), &slice);
   v1::MapSlice bad_mask = slice;
   bad_mask.mutable_masks(0)->set_encoding("gif");
-  EXPECT_THAT(decodeError(bad_mask), HasSubstr("encoding 'gif' is neither png nor rle"));
+  EXPECT_THAT(decodeError(bad_mask),
+              HasSubstr("encoding 'gif' is neither png/N (N 1..64) nor empty"));
+  bad_mask.mutable_masks(0)->set_encoding("png/0");
+  EXPECT_THAT(decodeError(bad_mask), HasSubstr("encoding 'png/0' is neither"));
+  bad_mask.mutable_masks(0)->set_encoding("empty");
+  EXPECT_THAT(decodeError(bad_mask), HasSubstr("encoding 'empty' with 5 data bytes"));
+  bad_mask.mutable_masks(0)->set_encoding("png/4");
+  bad_mask.mutable_masks(0)->set_segmentation_ms(-1.f);
+  EXPECT_THAT(decodeError(bad_mask), HasSubstr("segmentation time -1 ms"));
   v1::MapSlice zero_erased = slice;
   // Back from the last erased id to 0.
   zero_erased.add_points_erased(-static_cast<std::int64_t>(test::clientId(0, 5)));

@@ -1,0 +1,102 @@
+#include "client/semantic_frame_filter.h"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <stdexcept>
+
+#include "semantic/feature_subset.h"
+#include "semantic/mask_query.h"
+#include "util/timing_stats.h"
+
+namespace edgeslam {
+
+SemanticFrameFilter::SemanticFrameFilter(const PinholeCamera& camera, SemanticFilterOptions options)
+    : camera_(camera), options_(options) {}
+
+void SemanticFrameFilter::offerMask(std::size_t frame_index, cv::Mat1b labels) {
+  if (labels.empty()) throw std::invalid_argument("semantic filter: empty keyframe mask");
+  if (labels.cols != camera_.width() || labels.rows != camera_.height()) {
+    throw std::invalid_argument(fmt::format("semantic filter: mask is {}x{}, the camera {}x{}",
+                                            labels.cols, labels.rows, camera_.width(),
+                                            camera_.height()));
+  }
+  History since;  // the keyframe and the frames after it
+  {
+    std::lock_guard lock(mutex_);
+    ++counters_.masks_received;
+    for (const auto& entry : history_) {
+      if (entry.first >= frame_index) since.push_back(entry);
+    }
+    if (since.empty() || since.front().first != frame_index) {
+      ++counters_.masks_too_old;
+      spdlog::debug("mask of frame {} arrived past the history", frame_index);
+      return;
+    }
+  }
+  CarriedMask carried;
+  carried.keyframe_frame = frame_index;
+  carried.frame = frame_index;
+  carried.propagator = std::make_unique<MaskPropagator>(options_.propagation);
+  carried.propagator->setReference(std::move(labels), since.front().second);
+  // Steps of at most catch_up_step frames, ending on the newest frame seen.
+  const std::size_t step = std::max<std::size_t>(1, options_.catch_up_step);
+  for (std::size_t k = 1; k < since.size(); ++k) {
+    const bool last = k + 1 == since.size();
+    if (!last && since[k].first - carried.frame < step) continue;
+    carried.propagator->propagate(*since[k].second, since[k].first - carried.frame);
+    carried.frame = since[k].first;
+  }
+  std::lock_guard lock(mutex_);
+  // Only the newest keyframe's mask matters.
+  if (carried_ && carried_->keyframe_frame > frame_index) return;
+  carried_ = std::move(carried);
+}
+
+void SemanticFrameFilter::takeCarriedMask() {
+  std::optional<CarriedMask> carried;
+  {
+    std::lock_guard lock(mutex_);
+    carried.swap(carried_);
+  }
+  // An older keyframe's mask than the one in use brings nothing new.
+  if (!carried || (propagator_ && source_frame_ >= carried->keyframe_frame)) return;
+  propagator_ = std::move(carried->propagator);
+  source_frame_ = carried->keyframe_frame;
+  last_frame_ = carried->frame;
+  std::lock_guard lock(mutex_);
+  ++counters_.masks_applied;
+}
+
+SemanticFrame SemanticFrameFilter::filter(std::size_t frame_index,
+                                          std::shared_ptr<const FrameFeatures> all) {
+  Stopwatch timer;
+  SemanticFrame out;
+  out.all = all;
+  out.kept = all;
+  takeCarriedMask();
+  if (propagator_ && frame_index > last_frame_) {
+    MaskTransferResult transferred = propagator_->propagate(*all, frame_index - last_frame_);
+    last_frame_ = frame_index;
+    out.mask = std::move(transferred.mask);
+    out.mask_source_frame = source_frame_;
+    const std::vector<int> keep =
+        indicesOutsideMask(all->keypoints, out.mask, options_.cull_margin_px);
+    out.culled = static_cast<int>(all->size() - keep.size());
+    if (out.culled > 0) out.kept = selectFeatures(*all, keep, camera_);
+  }
+  out.elapsed_ms = timer.elapsedMs();
+  std::lock_guard lock(mutex_);
+  history_.emplace_back(frame_index, std::move(all));
+  while (history_.size() > options_.history_frames) history_.pop_front();
+  counters_.frames_with_mask += !out.mask.empty();
+  counters_.features_culled += static_cast<std::size_t>(out.culled);
+  return out;
+}
+
+SemanticFilterCounters SemanticFrameFilter::counters() const {
+  std::lock_guard lock(mutex_);
+  return counters_;
+}
+
+}  // namespace edgeslam

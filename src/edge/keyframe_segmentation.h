@@ -1,0 +1,80 @@
+#pragma once
+// Segmentation of keyframes on a worker thread of its own, so that mapping never waits for the
+// network's inference (paper Sec. IV-B: only keyframes are segmented). Jobs queue up to a bound;
+// beyond it the oldest waiting keyframe is skipped (a newer mask serves tracking better).
+#include <condition_variable>
+#include <cstddef>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <opencv2/core.hpp>
+#include <thread>
+
+#include "map/ids.h"
+#include "semantic/segmenter.h"
+#include "util/timing_stats.h"
+
+namespace edgeslam {
+
+struct KeyFrameSegmentationJob {
+  KeyFrameId keyframe = kInvalidId;
+  std::size_t frame_index = 0;
+  cv::Mat image;       // BGR or grey, possibly reduced
+  cv::Size full_size;  // the camera's image size: the labels come back at this size
+  int reduce = 1;      // the worker shrinks the image this many times before segmenting it
+};
+
+struct KeyFrameSegmentationResult {
+  KeyFrameId keyframe = kInvalidId;
+  std::size_t frame_index = 0;
+  cv::Mat1b labels;  // full_size, 0 = background, i + 1 = instance i
+  std::size_t instances = 0;
+  double segmentation_ms = 0.0;
+};
+
+struct KeyFrameSegmentationCounters {
+  std::size_t segmented = 0;
+  std::size_t skipped = 0;  // left the queue unsegmented
+  std::size_t failed = 0;
+  PercentileSummary segmentation_ms;
+};
+
+class KeyFrameSegmentationWorker {
+ public:
+  using Done = std::function<void(KeyFrameSegmentationResult)>;
+
+  // `done` runs on the worker thread. The segmenter is used by that thread only.
+  KeyFrameSegmentationWorker(std::shared_ptr<Segmenter> segmenter, Done done,
+                             std::size_t max_queued = 2);
+  ~KeyFrameSegmentationWorker();
+  KeyFrameSegmentationWorker(const KeyFrameSegmentationWorker&) = delete;
+  KeyFrameSegmentationWorker& operator=(const KeyFrameSegmentationWorker&) = delete;
+
+  void submit(KeyFrameSegmentationJob job);
+  // Box NMS threshold nm (paper Table I), applied from the next keyframe on.
+  void setNmsThreshold(float nm);
+  // Until the queue is empty and no keyframe is being segmented.
+  void waitUntilIdle();
+  void stop();
+  KeyFrameSegmentationCounters counters() const;
+
+ private:
+  void run();
+
+  std::shared_ptr<Segmenter> segmenter_;
+  Done done_;
+  std::size_t max_queued_;
+  mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  std::condition_variable idle_;
+  std::deque<KeyFrameSegmentationJob> queue_;
+  bool busy_ = false;
+  bool stopping_ = false;
+  float pending_nms_ = -1.f;
+  std::size_t segmented_ = 0, skipped_ = 0, failed_ = 0;
+  SampleStats segmentation_ms_;
+  std::thread thread_;
+};
+
+}  // namespace edgeslam

@@ -1,0 +1,91 @@
+#include "semantic/mask_propagator.h"
+
+#include <algorithm>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+namespace edgeslam {
+namespace {
+
+const cv::Matx23d kIdentity(1, 0, 0, 0, 1, 0);
+
+cv::Matx33d homogeneous(const cv::Matx23d& w) {
+  return cv::Matx33d(w(0, 0), w(0, 1), w(0, 2), w(1, 0), w(1, 1), w(1, 2), 0, 0, 1);
+}
+
+// w1 * w0^-1 * w1: the step from w0 to w1 taken once more.
+cv::Matx23d extrapolated(const cv::Matx23d& w0, const cv::Matx23d& w1) {
+  const cv::Matx33d h1 = homogeneous(w1);
+  const cv::Matx33d next = h1 * homogeneous(w0).inv() * h1;
+  return cv::Matx23d(next(0, 0), next(0, 1), next(0, 2), next(1, 0), next(1, 1), next(1, 2));
+}
+
+cv::Point2f apply(const cv::Matx23d& w, cv::Point2f p) {
+  return {static_cast<float>(w(0, 0) * p.x + w(0, 1) * p.y + w(0, 2)),
+          static_cast<float>(w(1, 0) * p.x + w(1, 1) * p.y + w(1, 2))};
+}
+
+}  // namespace
+
+MaskPropagator::MaskPropagator(MaskPropagatorOptions options) : options_(options) {
+  warps_.fill(kIdentity);
+  previous_warps_.fill(kIdentity);
+  last_step_frames_ = 0;
+}
+
+void MaskPropagator::setReference(cv::Mat1b labels, std::shared_ptr<const FrameFeatures> features) {
+  if (labels.empty()) throw std::invalid_argument("mask propagation: empty keyframe label image");
+  if (features == nullptr) throw std::invalid_argument("mask propagation: no keyframe features");
+  labels_ = std::move(labels);
+  const int margin = std::max(0, options_.transfer.near_margin_px);
+  if (margin > 0) {
+    // Grey dilation spreads each label over its neighbourhood (where labels meet, the larger
+    // wins, which only matters for choosing whom to search for).
+    cv::dilate(labels_, labels_near_,
+               cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * margin + 1, 2 * margin + 1)));
+  } else {
+    labels_near_ = labels_;
+  }
+  reference_ = std::move(features);
+  reference_has_instances_ = cv::countNonZero(labels_) > 0;
+  warps_.fill(kIdentity);
+}
+
+MaskTransferResult MaskPropagator::propagate(const FrameFeatures& current,
+                                             std::size_t frames_since_last) {
+  if (reference_ == nullptr) return {};
+  if (!reference_has_instances_) {
+    // Nothing movable in the keyframe: nothing to move along.
+    last_matches_ = {};
+    MaskTransferResult nothing;
+    nothing.labels = cv::Mat1b::zeros(labels_.size());
+    nothing.mask = nothing.labels.clone();
+    return nothing;
+  }
+  std::array<cv::Matx23d, 256> predicted = warps_;
+  if (last_step_frames_ == frames_since_last) {
+    for (std::size_t label = 0; label < predicted.size(); ++label) {
+      predicted[label] = extrapolated(previous_warps_[label], warps_[label]);
+    }
+  }
+  const MotionPrediction predict = [&predicted](std::uint8_t label, cv::Point2f p) {
+    return apply(predicted[label], p);
+  };
+  const float radius =
+      std::min(options_.max_search_radius_px,
+               options_.search_radius_px +
+                   options_.search_radius_per_frame_px *
+                       static_cast<float>(frames_since_last > 0 ? frames_since_last - 1 : 0));
+  last_matches_ =
+      matchForTransfer(*reference_, labels_near_, current, predict, radius, options_.matching);
+  MaskTransferResult result =
+      transferLabels(labels_, last_matches_.reference, last_matches_.current, options_.transfer);
+  previous_warps_ = warps_;
+  last_step_frames_ = frames_since_last;
+  for (cv::Matx23d& w : warps_) w = result.background.warp;
+  for (const TransferredInstance& instance : result.instances)
+    warps_[instance.label] = instance.warp;
+  return result;
+}
+
+}  // namespace edgeslam

@@ -1,0 +1,56 @@
+#pragma once
+// Carries a keyframe's movable-object labels forward to every following frame (paper Sec. IV-C):
+// each frame's mask is transferred from the keyframe directly (no accumulated drift), by feature
+// matches searched around where each instance's motion in the previous frame predicts them.
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <opencv2/core.hpp>
+
+#include "features/frame_features.h"
+#include "semantic/mask_transfer.h"
+#include "semantic/transfer_matching.h"
+
+namespace edgeslam {
+
+struct MaskPropagatorOptions {
+  MaskTransferOptions transfer;
+  TransferMatchOptions matching;
+  float search_radius_px = 28.f;  // around the predicted position, one frame after the last
+  // The search widens by this much per further frame since the last propagation (a late mask is
+  // first carried to a frame some way past its keyframe), up to max_search_radius_px.
+  float search_radius_per_frame_px = 8.f;
+  float max_search_radius_px = 96.f;
+};
+
+class MaskPropagator {
+ public:
+  explicit MaskPropagator(MaskPropagatorOptions options = {});
+
+  // The labels (full image size, 0 = background) of the keyframe whose features are `features`.
+  // Throws std::invalid_argument for an empty label image or features.
+  void setReference(cv::Mat1b labels, std::shared_ptr<const FrameFeatures> features);
+  bool hasReference() const { return reference_ != nullptr; }
+
+  // The reference's labels moved to `current`, which comes `frames_since_last` frames after the
+  // last frame propagated to (or the keyframe). Without a reference: empty labels and mask.
+  MaskTransferResult propagate(const FrameFeatures& current, std::size_t frames_since_last = 1);
+  // Matches used by the last propagation (for diagnostics).
+  const TransferMatches& lastMatches() const { return last_matches_; }
+
+ private:
+  MaskPropagatorOptions options_;
+  cv::Mat1b labels_;
+  cv::Mat1b labels_near_;
+  std::shared_ptr<const FrameFeatures> reference_;
+  bool reference_has_instances_ = false;
+  // Per label ([0] background), keyframe -> the last frame propagated to, and -> the one before:
+  // their difference is the label's motion, assumed to go on (constant velocity) when the next
+  // step spans as many frames as the last.
+  std::array<cv::Matx23d, 256> warps_;
+  std::array<cv::Matx23d, 256> previous_warps_;
+  std::size_t last_step_frames_ = 0;
+  TransferMatches last_matches_;
+};
+
+}  // namespace edgeslam
