@@ -170,8 +170,9 @@ int runPipeline(const RunOptions& options) {
   slam_options.loop_closing = options.loop_closing;
   slam_options.semantic = options.semantic;
   slam_options.keyframe_image_reduce = options.segment_reduce;
-  if (options.semantic) {
-    // Loaded here even in edge mode: a missing model is reported before any frame is read.
+  if (options.semantic && options.server_address.empty()) {
+    // Loaded here also for the embedded edge: a missing model is reported before any frame is
+    // read. A remote edge server checks its own models when the session opens.
     std::shared_ptr<Segmenter> segmenter =
         loadSegmenter(segmenterOptions(options.models_dir, options.segment_input));
     if (mode == "local") slam_options.segmenter = std::move(segmenter);

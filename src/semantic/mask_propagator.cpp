@@ -36,29 +36,19 @@ MaskPropagator::MaskPropagator(MaskPropagatorOptions options) : options_(options
 void MaskPropagator::setReference(cv::Mat1b labels, std::shared_ptr<const FrameFeatures> features) {
   if (labels.empty()) throw std::invalid_argument("mask propagation: empty keyframe label image");
   if (features == nullptr) throw std::invalid_argument("mask propagation: no keyframe features");
-  labels_ = std::move(labels);
-  const int margin = std::max(0, options_.transfer.near_margin_px);
-  if (margin > 0) {
-    // Grey dilation spreads each label over its neighbourhood (where labels meet, the larger
-    // wins, which only matters for choosing whom to search for).
-    cv::dilate(labels_, labels_near_,
-               cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * margin + 1, 2 * margin + 1)));
-  } else {
-    labels_near_ = labels_;
-  }
+  labels_ = prepareLabels(std::move(labels), options_.transfer.near_margin_px);
   reference_ = std::move(features);
-  reference_has_instances_ = cv::countNonZero(labels_) > 0;
   warps_.fill(kIdentity);
 }
 
 MaskTransferResult MaskPropagator::propagate(const FrameFeatures& current,
                                              std::size_t frames_since_last) {
   if (reference_ == nullptr) return {};
-  if (!reference_has_instances_) {
+  if (!labels_.any) {
     // Nothing movable in the keyframe: nothing to move along.
     last_matches_ = {};
     MaskTransferResult nothing;
-    nothing.labels = cv::Mat1b::zeros(labels_.size());
+    nothing.labels = cv::Mat1b::zeros(labels_.labels.size());
     nothing.mask = nothing.labels.clone();
     return nothing;
   }
@@ -76,8 +66,8 @@ MaskTransferResult MaskPropagator::propagate(const FrameFeatures& current,
                options_.search_radius_px +
                    options_.search_radius_per_frame_px *
                        static_cast<float>(frames_since_last > 0 ? frames_since_last - 1 : 0));
-  last_matches_ =
-      matchForTransfer(*reference_, labels_near_, current, predict, radius, options_.matching);
+  last_matches_ = matchForTransfer(*reference_, labels_.labels_near, current, predict, radius,
+                                   options_.matching);
   MaskTransferResult result =
       transferLabels(labels_, last_matches_.reference, last_matches_.current, options_.transfer);
   previous_warps_ = warps_;

@@ -40,10 +40,8 @@ class MaskPropagator {
 
  private:
   MaskPropagatorOptions options_;
-  cv::Mat1b labels_;
-  cv::Mat1b labels_near_;
+  PreparedLabels labels_;
   std::shared_ptr<const FrameFeatures> reference_;
-  bool reference_has_instances_ = false;
   // Per label ([0] background), keyframe -> the last frame propagated to, and -> the one before:
   // their difference is the label's motion, assumed to go on (constant velocity) when the next
   // step spans as many frames as the last.

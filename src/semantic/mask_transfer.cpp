@@ -34,19 +34,6 @@ std::array<InstanceExtent, kLabels> instanceExtents(const cv::Mat1b& labels) {
   return extents;
 }
 
-// Label within `margin` of (x, y), 0 when none.
-std::uint8_t labelNear(const cv::Mat1b& labels, int x, int y, int margin) {
-  const cv::Rect window = cv::Rect(x - margin, y - margin, 2 * margin + 1, 2 * margin + 1) &
-                          cv::Rect(0, 0, labels.cols, labels.rows);
-  for (int row = window.y; row < window.y + window.height; ++row) {
-    const std::uint8_t* pixels = labels.ptr<std::uint8_t>(row);
-    for (int col = window.x; col < window.x + window.width; ++col) {
-      if (pixels[col] != 0) return pixels[col];
-    }
-  }
-  return 0;
-}
-
 double median(std::vector<double> values) {
   const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
   std::nth_element(values.begin(), middle, values.end());
@@ -145,6 +132,28 @@ const char* toString(InstanceMotion motion) {
   return "?";
 }
 
+PreparedLabels prepareLabels(cv::Mat1b labels, int near_margin_px) {
+  if (labels.empty()) throw std::invalid_argument("mask transfer of an empty label image");
+  PreparedLabels prepared;
+  prepared.labels = std::move(labels);
+  const std::array<InstanceExtent, kLabels> extents = instanceExtents(prepared.labels);
+  for (std::size_t label = 1; label < extents.size(); ++label) {
+    if (!extents[label].present()) continue;
+    prepared.boxes[label] = extents[label].rect();
+    prepared.any = true;
+  }
+  prepared.near_margin_px = std::max(0, near_margin_px);
+  if (prepared.any && prepared.near_margin_px > 0) {
+    // Grey dilation spreads each label over its neighbourhood (where two meet, the larger wins).
+    const int side = 2 * prepared.near_margin_px + 1;
+    cv::dilate(prepared.labels, prepared.labels_near,
+               cv::getStructuringElement(cv::MORPH_RECT, cv::Size(side, side)));
+  } else {
+    prepared.labels_near = prepared.labels;
+  }
+  return prepared;
+}
+
 MaskTransferResult transferLabels(const cv::Mat1b& keyframe_labels,
                                   const std::vector<cv::Point2f>& keyframe_points,
                                   const std::vector<cv::Point2f>& current_points,
@@ -154,24 +163,29 @@ MaskTransferResult transferLabels(const cv::Mat1b& keyframe_labels,
                                 std::to_string(keyframe_points.size()) + " and " +
                                 std::to_string(current_points.size()));
   }
+  return transferLabels(prepareLabels(keyframe_labels, options.near_margin_px), keyframe_points,
+                        current_points, options);
+}
+
+MaskTransferResult transferLabels(const PreparedLabels& prepared,
+                                  const std::vector<cv::Point2f>& keyframe_points,
+                                  const std::vector<cv::Point2f>& current_points,
+                                  const MaskTransferOptions& options) {
+  const cv::Mat1b& keyframe_labels = prepared.labels;
+  if (keyframe_points.size() != current_points.size()) {
+    throw std::invalid_argument("mask transfer needs matched point lists of equal length, got " +
+                                std::to_string(keyframe_points.size()) + " and " +
+                                std::to_string(current_points.size()));
+  }
   if (keyframe_labels.empty()) throw std::invalid_argument("mask transfer of an empty label image");
+  if (prepared.near_margin_px != std::max(0, options.near_margin_px)) {
+    throw std::invalid_argument("labels prepared for another near margin");
+  }
   MaskTransferResult result;
   result.labels = cv::Mat1b::zeros(keyframe_labels.size());
   result.mask = cv::Mat1b::zeros(keyframe_labels.size());
-  if (cv::countNonZero(keyframe_labels) == 0) return result;
+  if (!prepared.any) return result;
 
-  const std::array<InstanceExtent, kLabels> extents = instanceExtents(keyframe_labels);
-  // Instance boxes grown by the margin: only points inside one need the (costlier) near search.
-  std::vector<cv::Rect> near_zones;
-  for (const InstanceExtent& extent : extents) {
-    if (!extent.present()) continue;
-    const int m = options.near_margin_px;
-    near_zones.push_back(extent.rect() + cv::Size(2 * m, 2 * m) - cv::Point(m, m));
-  }
-  auto inNearZone = [&](cv::Point p) {
-    return std::any_of(near_zones.begin(), near_zones.end(),
-                       [&](const cv::Rect& zone) { return zone.contains(p); });
-  };
   std::array<std::vector<int>, kLabels> on_instance, near_instance;
   std::vector<int> background;
   const cv::Rect image(0, 0, keyframe_labels.cols, keyframe_labels.rows);
@@ -184,8 +198,7 @@ MaskTransferResult transferLabels(const cv::Mat1b& keyframe_labels,
       continue;
     }
     background.push_back(static_cast<int>(i));
-    if (options.near_margin_px <= 0 || !inNearZone(cv::Point(x, y))) continue;
-    const std::uint8_t near = labelNear(keyframe_labels, x, y, options.near_margin_px);
+    const std::uint8_t near = prepared.labels_near(y, x);
     if (near != 0) near_instance[near].push_back(static_cast<int>(i));
   }
 
@@ -206,15 +219,15 @@ MaskTransferResult transferLabels(const cv::Mat1b& keyframe_labels,
   }
 
   for (int label = kLabels - 1; label >= 1; --label) {  // label 1 (best score) painted last
-    const InstanceExtent& extent = extents[static_cast<std::size_t>(label)];
-    if (!extent.present()) continue;
+    const cv::Rect& box = prepared.boxes[static_cast<std::size_t>(label)];
+    if (box.empty()) continue;
     from.clear();
     to.clear();
     const auto& own = on_instance[static_cast<std::size_t>(label)];
     gather(own.empty() ? near_instance[static_cast<std::size_t>(label)] : own, from, to);
     TransferredInstance moved = fitMotion(from, to, options, background_fallback);
     moved.label = static_cast<std::uint8_t>(label);
-    paintWarped(keyframe_labels, moved.label, extent.rect(), moved.warp, result.labels);
+    paintWarped(keyframe_labels, moved.label, box, moved.warp, result.labels);
     result.instances.push_back(moved);
   }
   std::reverse(result.instances.begin(), result.instances.end());

@@ -15,6 +15,7 @@
 //
 // The matches should be the raw keyframe -> current feature matches, including features on the
 // movable objects (before dynamic culling): those are what tell how the objects moved.
+#include <array>
 #include <cstdint>
 #include <opencv2/core.hpp>
 #include <vector>
@@ -27,7 +28,7 @@ struct MaskTransferOptions {
   double ransac_threshold_px = 3.0;
   double min_inlier_ratio = 0.5;  // of the matches used for the similarity
   double max_scale_change = 2.5;  // similarities scaling by more (or less than 1/this) are rejected
-  int ransac_iterations = 200;
+  int ransac_iterations = 100;
   int merge_gap_px = 4;  // transferMask: mask fragments closer than this move as one instance
 };
 
@@ -50,9 +51,27 @@ struct MaskTransferResult {
   TransferredInstance background;
 };
 
+// A keyframe's label image with what every transfer from it needs, computed once (transfers of
+// one keyframe to many frames reuse it).
+struct PreparedLabels {
+  cv::Mat1b labels;
+  cv::Mat1b labels_near;  // labels grown by near_margin_px (0 = background)
+  int near_margin_px = 0;
+  std::array<cv::Rect, 256> boxes;  // bounding box per label, empty where absent
+  bool any = false;                 // some label present
+};
+
+// Throws std::invalid_argument for an empty image.
+PreparedLabels prepareLabels(cv::Mat1b labels, int near_margin_px);
+
 // `keyframe_points[i]` matches `current_points[i]` (pixels). Throws std::invalid_argument when the
 // two lists differ in length.
 MaskTransferResult transferLabels(const cv::Mat1b& keyframe_labels,
+                                  const std::vector<cv::Point2f>& keyframe_points,
+                                  const std::vector<cv::Point2f>& current_points,
+                                  const MaskTransferOptions& options = {});
+// The same from prepared labels (prepared with options.near_margin_px).
+MaskTransferResult transferLabels(const PreparedLabels& keyframe,
                                   const std::vector<cv::Point2f>& keyframe_points,
                                   const std::vector<cv::Point2f>& current_points,
                                   const MaskTransferOptions& options = {});

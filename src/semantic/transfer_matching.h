@@ -16,7 +16,7 @@ namespace edgeslam {
 struct TransferMatchOptions {
   int max_descriptor_distance = 64;
   float ratio = 0.9f;         // best distance below ratio * second best (different positions)
-  int background_stride = 2;  // every n-th background feature is searched for
+  int background_stride = 4;  // every n-th background feature is searched for
   int level_window = 1;       // pyramid levels either side of the keyframe feature's
 };
 

@@ -61,9 +61,7 @@ TEST(SemanticFrameFilter, LateKeyframeMasksFollowThePeopleOnAGeneratedSequence) 
   OrbExtractor extractor;
   SemanticFrameFilter filter(reader->camera());
   // Keyframes every 10 frames; each mask arrives 4 frames after its keyframe (the edge's delay).
-  const std::size_t kKeyFrameEvery = 10;
-  const std::size_t kMaskDelay =
-      std::getenv("MASK_DELAY") ? std::stoul(std::getenv("MASK_DELAY")) : 4;
+  constexpr std::size_t kKeyFrameEvery = 10, kMaskDelay = 4;
   SampleStats iou, client_ms;
   std::size_t on_people = 0, on_people_kept = 0;
   for (std::size_t i = 0; i < reader->info().frame_count; ++i) {
@@ -77,11 +75,7 @@ TEST(SemanticFrameFilter, LateKeyframeMasksFollowThePeopleOnAGeneratedSequence) 
     client_ms.add(out.elapsed_ms);
     const cv::Mat1b truth = masks->load(i);
     if (i % kKeyFrameEvery != 0) {
-      if (const auto score = maskIoU(out.mask, truth)) {
-        iou.add(*score);
-        if (std::getenv("EDGESLAM_TEST_VERBOSE"))
-          std::printf("frame %zu IoU %.3f truth %d px\n", i, *score, cv::countNonZero(truth));
-      }
+      if (const auto score = maskIoU(out.mask, truth)) iou.add(*score);
     }
     on_people += countFeaturesOnMask(positions(*out.all), truth).on_mask;
     on_people_kept += countFeaturesOnMask(positions(*out.kept), truth).on_mask;
