@@ -20,6 +20,7 @@ void EdgeKeyFrameSink::insertKeyFrame(KeyFrame* keyframe) {
       upload.new_points.push_back(mapPointRecord(*p));
       uploaded_points_.insert(p->id());
     }
+    upload.segmenter_nms = segmenter_nms_.load();
     upload.map_reset = reset_pending_;
     reset_pending_ = false;
     if (!image_.empty() && image_frame_ == keyframe->frameIndex()) upload.raw_image = image_;

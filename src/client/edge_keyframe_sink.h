@@ -31,6 +31,8 @@ class EdgeKeyFrameSink : public KeyFrameSink {
   // The image of the frame about to be tracked: if that frame becomes a keyframe, the image goes
   // up with it (for segmentation on the edge). Call on the tracking thread.
   void attachImage(std::size_t frame_index, cv::Mat image);
+  // The segmenter NMS threshold the next uploads ask the edge for (0 = the edge's own).
+  void setSegmenterNms(float nm) { segmenter_nms_ = nm; }
 
   // A slice answering upload `upload_sequence` was applied; returns the seconds since that upload
   // was sent (negative when unknown), for the slice-latency statistics.
@@ -50,6 +52,7 @@ class EdgeKeyFrameSink : public KeyFrameSink {
   std::atomic<std::uint64_t> answered_{0};
   std::atomic<std::size_t> last_optimized_frame_{0};
   bool reset_pending_ = false;
+  std::atomic<float> segmenter_nms_{0.f};
   std::size_t image_frame_ = 0;
   cv::Mat image_;
   std::unordered_set<MapPointId> uploaded_points_;

@@ -89,6 +89,9 @@ void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
     upload_of_keyframe_[keyframe->id()] = upload.sequence;
     newest_keyframe_ = keyframe->id();
   }
+  if (segmentation_ != nullptr && upload.segmenter_nms > 0.f) {
+    segmentation_->setNmsThreshold(upload.segmenter_nms);
+  }
   if (!image.empty()) {
     segmentation_->submit({keyframe->id(), keyframe->frameIndex(), std::move(image),
                            cv::Size(camera_.width(), camera_.height())});

@@ -67,6 +67,8 @@ struct KeyFrameUpload {
   // tracking does not pay for the compression.
   cv::Mat raw_image;
   std::uint64_t acknowledged_slice = 0;  // last slice the client applied
+  // Box NMS threshold nm for segmenting this and later keyframes (paper Table I); 0 = the edge's.
+  float segmenter_nms = 0.f;
 };
 
 // A point that only moved: the receiver recomputes normal and distance range itself.

@@ -386,6 +386,10 @@ KeyFrameUpload fromProto(const v1::KeyFrameUpload& in) {
     if (!in.has_keyframe()) throw WireError("keyframe is missing");
     out.keyframe = fromProto(in.keyframe());
     out.map_reset = in.map_reset();
+    if (!(in.segmenter_nms() >= 0.f && in.segmenter_nms() <= 1.f)) {
+      throw WireError(fmt::format("segmenter NMS threshold {} outside [0, 1]", in.segmenter_nms()));
+    }
+    out.segmenter_nms = in.segmenter_nms();
     out.new_points = within("new points", [&] { return fromProto(in.new_points()); });
     const std::string& encoding = in.image_encoding();
     if (encoding.empty() != in.image().empty() ||

@@ -321,6 +321,7 @@ void toProto(const KeyFrameUpload& upload, v1::KeyFrameUpload* out,
   out->set_image(upload.image_bytes.data(), upload.image_bytes.size());
   out->set_acknowledged_slice(upload.acknowledged_slice);
   out->set_map_reset(upload.map_reset);
+  out->set_segmenter_nms(upload.segmenter_nms);
 }
 
 void toProto(const MaskRecord& mask, v1::Mask* out) {

@@ -60,8 +60,10 @@ void EdgeSlam::applyConfiguration(const KeyframeConfig& config) {
   kf.alpha = config.alpha;
   kf.beta = config.beta;
   extractor_.setNumLevels(config.pyramid_levels);
-  spdlog::info("adaptation: keyframes fmin {} fmax {} alpha {} beta {}, {} pyramid levels", kf.fmin,
-               kf.fmax, kf.alpha, kf.beta, config.pyramid_levels);
+  sink_->setSegmenterNms(static_cast<float>(config.nms_threshold));
+  spdlog::info(
+      "adaptation: keyframes fmin {} fmax {} alpha {} beta {}, {} pyramid levels, segmenter nm {}",
+      kf.fmin, kf.fmax, kf.alpha, kf.beta, config.pyramid_levels, config.nms_threshold);
 }
 
 void EdgeSlam::onSlice(MapSlice slice) {

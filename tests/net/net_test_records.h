@@ -84,6 +84,7 @@ inline KeyFrameUpload sampleUpload(std::uint64_t sequence, int keypoints, int ne
   u.image_encoding = "jpeg";
   u.image_bytes = {0xff, 0xd8, 0xff, 0xe0, 1, 2, 3};
   u.acknowledged_slice = sequence > 1 ? sequence - 1 : 0;
+  u.segmenter_nms = 0.7f;
   return u;
 }
 

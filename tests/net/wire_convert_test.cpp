@@ -270,6 +270,7 @@ TEST(WireConvert, UploadRoundTrip) {
     EXPECT_EQ(back.image_encoding, u.image_encoding);
     EXPECT_EQ(back.image_bytes, u.image_bytes);
     EXPECT_EQ(back.acknowledged_slice, u.acknowledged_slice);
+    EXPECT_FLOAT_EQ(back.segmenter_nms, 0.7f);
   }
   u.map_reset = false;
   v1::KeyFrameUpload plain;
