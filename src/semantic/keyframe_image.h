@@ -7,7 +7,7 @@ namespace edgeslam {
 
 struct KeyFrameImageOptions {
   int downscale = 2;  // each side divided by this (area averaging)
-  int jpeg_quality = 80;
+  int jpeg_quality = 60;
 };
 
 // Moves upload.raw_image (8-bit grey or BGR) into image_bytes / image_encoding; nothing to do
