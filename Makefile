@@ -52,6 +52,7 @@ bench: build
 	@BUILD_DIR=$(BUILD_DIR) bash bench/run.sh
 	@python3 bench/slam_bench.py --build $(BUILD_DIR) --shared $(EDGESLAM_SHARED) --modes local,edge,offload
 	@python3 bench/link_experiments.py --build-dir $(BUILD_DIR)
+	@python3 bench/semantic_bench.py --build-dir $(BUILD_DIR) --shared $(EDGESLAM_SHARED)
 
 format:
 	@git ls-files '*.cpp' '*.h' | xargs clang-format -i
