@@ -124,6 +124,12 @@ void report(const char* name, const RunOutcome& with, const RunOutcome& without)
 // verification, correction and global BA on real frames, outbound keyframes at least 100 frames
 // older are allowed as candidates here: the loop found must be right (many inliers, tiny
 // correction) and must not make the trajectory worse.
+// Searched for a sequence with drift to correct (this vocabulary, unthreaded): the whole walk at
+// stride 2 (its end comes back to its start) stays one connected map, RGB-D 4.8 cm and mono 4.1 cm
+// ATE, and the normal rule finds no loop (candidates fail verification with 7-19 BoW matches);
+// with old connected keyframes allowed it closes 618 -> 214 and 894 -> 214 by moving the
+// keyframe 1-6 mm. A there-and-back over 0..600 at stride 3 re-joins too (mono 3.3 cm), and a cut
+// back to frame 0 after 0..500 is relocalised within 2 frames. This map has no drift to correct.
 class ThereAndBack : public ::testing::TestWithParam<Sensor> {};
 
 TEST_P(ThereAndBack, ClosesTheRevisitAndKeepsTheTrajectory) {
