@@ -370,7 +370,8 @@ void addRunOptions(CLI::App* run, const std::shared_ptr<RunOptions>& options) {
   run->add_option("--adapt", options->adapt, "Self-adaptation on|off")
       ->transform(
           CLI::CheckedTransformer(std::map<std::string, bool>{{"on", true}, {"off", false}}));
-  run->add_option("--semantic", options->semantic, "Semantic culling on|off")
+  run->add_option("--semantic", options->semantic,
+                  "Semantic culling on|off (default off): keyframes segmented, people culled")
       ->transform(
           CLI::CheckedTransformer(std::map<std::string, bool>{{"on", true}, {"off", false}}));
   run->add_option("--models", options->models_dir,

@@ -19,7 +19,8 @@ SegmenterOptions segmenterOptions(const std::filesystem::path& models_dir, int d
 std::shared_ptr<Segmenter> loadSegmenter(const SegmenterOptions& options) {
   try {
     return makeSegmenter(options);
-  } catch (const std::exception& e) {
+  } catch (const std::runtime_error& e) {
+    // A missing or unreadable model (bad options are std::invalid_argument and say so themselves).
     throw std::runtime_error(std::string(e.what()) +
                              " (semantic culling needs the segmentation models: pass --models DIR "
                              "or set EDGESLAM_SHARED; or run with --semantic off)");

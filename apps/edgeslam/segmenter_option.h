@@ -12,7 +12,8 @@ namespace edgeslam::cli {
 SegmenterOptions segmenterOptions(const std::filesystem::path& models_dir,
                                   int detector_input = 256);
 
-// Loads the models once; throws std::runtime_error naming the file and how to fix it.
+// Loads the models once; throws std::runtime_error naming the file and how to fix it, or
+// std::invalid_argument for bad options (e.g. a detector input that is not a multiple of 32).
 std::shared_ptr<Segmenter> loadSegmenter(const SegmenterOptions& options);
 
 }  // namespace edgeslam::cli
