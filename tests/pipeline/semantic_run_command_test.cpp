@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "io/temp_folder.h"
 #include "support/edgeslam_command.h"
 #include "support/shared_data.h"
 
@@ -18,9 +19,16 @@ namespace {
 namespace fs = std::filesystem;
 constexpr const char* kSequence = "datasets/7scenes-redkitchen-1000";
 
+// ctest runs each test in its own process, several at once: every folder is the process's own
+// (and removed when it exits).
+fs::path ownTempFolder(const std::string& name) {
+  static const test::TempFolder scratch;
+  return scratch / name;
+}
+
 const fs::path& dynamicSequence() {
   static const fs::path folder = [] {
-    const fs::path out = fs::temp_directory_path() / "edgeslam_semantic_run_test_sequence";
+    const fs::path out = ownTempFolder("sequence");
     fs::remove_all(out);
     const auto r =
         test::runEdgeslam("synth-dynamic --dataset " + test::sharedPath(kSequence).string() +
@@ -32,8 +40,7 @@ const fs::path& dynamicSequence() {
 }
 
 nlohmann::json runSemantic(const std::string& mode, const std::string& semantic) {
-  const fs::path out =
-      fs::temp_directory_path() / ("edgeslam_semantic_run_test_" + mode + semantic);
+  const fs::path out = ownTempFolder(mode + semantic);
   fs::remove_all(out);
   const auto r = test::runEdgeslam("run --dataset " + dynamicSequence().string() + " --mode " +
                                    mode + " --sensor rgbd --semantic " + semantic +
