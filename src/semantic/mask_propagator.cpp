@@ -54,7 +54,9 @@ MaskTransferResult MaskPropagator::propagate(const FrameFeatures& current,
   }
   std::array<cv::Matx23d, 256> predicted = warps_;
   if (last_step_frames_ == frames_since_last) {
+    // Only the background and the labels present move; the others are never looked up.
     for (std::size_t label = 0; label < predicted.size(); ++label) {
+      if (label != 0 && labels_.boxes[label].empty()) continue;
       predicted[label] = extrapolated(previous_warps_[label], warps_[label]);
     }
   }

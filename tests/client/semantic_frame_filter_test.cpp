@@ -8,18 +8,10 @@
 #include <random>
 #include <stdexcept>
 
+#include "map/synthetic_views.h"
+
 namespace edgeslam {
 namespace {
-
-PinholeCamera vgaCamera() {
-  CameraIntrinsics intrinsics;
-  intrinsics.width = 640;
-  intrinsics.height = 480;
-  intrinsics.fx = intrinsics.fy = 500;
-  intrinsics.cx = 320;
-  intrinsics.cy = 240;
-  return PinholeCamera(intrinsics);
-}
 
 // A 30 x 20 lattice of features with distinct random descriptors; those inside `object` are moved
 // by `object_shift`, the rest by `background_shift`.
@@ -39,7 +31,7 @@ std::shared_ptr<FrameFeatures> lattice(const cv::Rect& object, cv::Point2f objec
       for (int b = 0; b < 32; ++b) f->descriptors.at<std::uint8_t>(i, b) = byte(random);
     }
   }
-  f->grid = FeatureGrid(vgaCamera().undistortedBounds(), f->keypoints);
+  f->grid = FeatureGrid(test::syntheticCamera().undistortedBounds(), f->keypoints);
   return f;
 }
 
@@ -50,7 +42,7 @@ cv::Mat1b labelsWith(const cv::Rect& object) {
 }
 
 TEST(SemanticFrameFilter, WithoutAMaskEveryFeatureIsKept) {
-  SemanticFrameFilter filter(vgaCamera());
+  SemanticFrameFilter filter(test::syntheticCamera());
   const auto features = lattice({}, {}, {});
   const SemanticFrame out = filter.filter(0, features);
   EXPECT_EQ(out.kept, features);
@@ -62,7 +54,7 @@ TEST(SemanticFrameFilter, CullsTheFeaturesOnAMovingObjectAndKeepsTheOthers) {
   const cv::Rect object(200, 150, 120, 160);
   SemanticFilterOptions options;
   options.cull_margin_px = 0;  // exactly the features on the object
-  SemanticFrameFilter filter(vgaCamera(), options);
+  SemanticFrameFilter filter(test::syntheticCamera(), options);
   filter.filter(0, lattice(object, {}, {}));
   filter.filter(1, lattice(object, {4, 2}, {1, 0}));
   filter.offerMask(0, labelsWith(object));  // arrives while frame 2 is due
@@ -87,7 +79,7 @@ TEST(SemanticFrameFilter, CullsTheFeaturesOnAMovingObjectAndKeepsTheOthers) {
 
 TEST(SemanticFrameFilter, AnEmptyKeyframeMaskClearsTheOldOne) {
   const cv::Rect object(200, 150, 120, 160);
-  SemanticFrameFilter filter(vgaCamera());
+  SemanticFrameFilter filter(test::syntheticCamera());
   filter.filter(0, lattice(object, {}, {}));
   filter.offerMask(0, labelsWith(object));
   EXPECT_GT(filter.filter(1, lattice(object, {}, {})).culled, 0);
@@ -100,7 +92,7 @@ TEST(SemanticFrameFilter, AnEmptyKeyframeMaskClearsTheOldOne) {
 TEST(SemanticFrameFilter, RefusesMisSizedMasksAndCountsMasksPastTheHistory) {
   SemanticFilterOptions options;
   options.history_frames = 5;
-  SemanticFrameFilter filter(vgaCamera(), options);
+  SemanticFrameFilter filter(test::syntheticCamera(), options);
   EXPECT_THROW(filter.offerMask(0, cv::Mat1b::zeros(240, 320)), std::invalid_argument);
   EXPECT_THROW(filter.offerMask(0, cv::Mat1b()), std::invalid_argument);
   for (std::size_t i = 0; i < 10; ++i) filter.filter(i, lattice({}, {}, {}));

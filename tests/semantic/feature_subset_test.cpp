@@ -4,20 +4,11 @@
 
 #include <stdexcept>
 
+#include "map/synthetic_views.h"
 #include "semantic/keyframe_image.h"
 
 namespace edgeslam {
 namespace {
-
-PinholeCamera vgaCamera() {
-  CameraIntrinsics intrinsics;
-  intrinsics.width = 640;
-  intrinsics.height = 480;
-  intrinsics.fx = intrinsics.fy = 500;
-  intrinsics.cx = 320;
-  intrinsics.cy = 240;
-  return PinholeCamera(intrinsics);
-}
 
 FrameFeatures rowOfFeatures(int n, bool with_depth) {
   FrameFeatures f;
@@ -36,7 +27,7 @@ FrameFeatures rowOfFeatures(int n, bool with_depth) {
 
 TEST(SelectFeatures, KeepsTheListedKeypointsWithTheirDescriptorsDepthAndGrid) {
   const FrameFeatures all = rowOfFeatures(10, true);
-  const auto kept = selectFeatures(all, {1, 4, 9}, vgaCamera());
+  const auto kept = selectFeatures(all, {1, 4, 9}, test::syntheticCamera());
   ASSERT_EQ(kept->size(), 3u);
   EXPECT_EQ(kept->keypoints[1].pt, all.keypoints[4].pt);
   EXPECT_EQ(kept->keypoints[2].octave, all.keypoints[9].octave);
@@ -50,11 +41,11 @@ TEST(SelectFeatures, KeepsTheListedKeypointsWithTheirDescriptorsDepthAndGrid) {
 
 TEST(SelectFeatures, NoDepthStaysNoDepthAndBadIndicesThrow) {
   const FrameFeatures all = rowOfFeatures(4, false);
-  const auto kept = selectFeatures(all, {0, 3}, vgaCamera());
+  const auto kept = selectFeatures(all, {0, 3}, test::syntheticCamera());
   EXPECT_TRUE(kept->depth.empty());
   EXPECT_FALSE(kept->hasDepth(0));
-  EXPECT_THROW(selectFeatures(all, {0, 4}, vgaCamera()), std::out_of_range);
-  EXPECT_EQ(selectFeatures(all, {}, vgaCamera())->size(), 0u);
+  EXPECT_THROW(selectFeatures(all, {0, 4}, test::syntheticCamera()), std::out_of_range);
+  EXPECT_EQ(selectFeatures(all, {}, test::syntheticCamera())->size(), 0u);
 }
 
 TEST(KeyFrameImage, IsReducedAndJpegCodedAndTheRawImageDropped) {
