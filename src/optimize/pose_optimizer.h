@@ -34,6 +34,11 @@ struct PoseOptimizerOptions {
   // the quadratic zone of the kernel, so further rounds (with or without it) start at their
   // optimum.
   bool stop_when_stable = true;
+  // All active observations in one compressed residual block (pose_batch_cost.h), rebuilt each
+  // round: the same cost, gradient and steps as one block per observation, ~3.5x faster. false:
+  // one block per observation with a ceres::HuberLoss each (the reference the benchmark and the
+  // tests compare with).
+  bool single_residual_block = true;
 };
 
 struct PoseOptimizerResult {

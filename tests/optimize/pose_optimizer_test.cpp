@@ -145,6 +145,28 @@ TEST(PoseOptimizer, RejectsBadInput) {
   EXPECT_THROW(optimizePose(scene.T_cw, scene.observations, bad), std::invalid_argument);
 }
 
+TEST(PoseOptimizer, SingleBlockTakesTheStepsOfOneBlockPerObservation) {
+  std::mt19937 rng(17);
+  for (int trial = 0; trial < 5; ++trial) {
+    Scene scene = makeScene(400, rng, 2, 1.0);
+    for (std::size_t i = 0; i < scene.observations.size(); i += 8) {  // 12.5 % outliers
+      scene.observations[i].pixel += Eigen::Vector2d(25.0, -40.0);
+    }
+    const SE3d start = test::perturb(scene.T_cw, 0.05, degToRad(3.0), rng);
+    PoseOptimizerOptions reference;
+    reference.single_residual_block = false;
+    const PoseOptimizerResult batched = optimizePose(start, scene.observations, testCamera());
+    const PoseOptimizerResult per_block =
+        optimizePose(start, scene.observations, testCamera(), reference);
+    EXPECT_EQ(batched.outliers, per_block.outliers);
+    EXPECT_EQ(batched.inliers, per_block.inliers);
+    EXPECT_EQ(batched.iterations, per_block.iterations);
+    EXPECT_LT(test::translationError(batched.T_cw, per_block.T_cw), 1e-8);
+    EXPECT_LT(radToDeg(rotationDistance(batched.T_cw, per_block.T_cw)), 1e-7);
+    EXPECT_LT(test::translationError(batched.T_cw, scene.T_cw), 0.02);
+  }
+}
+
 TEST(PoseOptimizer, TimingFor300Observations) {
   std::mt19937 rng(16);
   Scene scene = makeScene(300, rng, 0, 1.0);
