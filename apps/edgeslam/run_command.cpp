@@ -94,6 +94,10 @@ EdgeEndpoint openEdge(const RunOptions& options, std::shared_ptr<const Vocabular
     session.segmenter = segmenterOptions(options.models_dir, options.segment_input);
   session.mapping.vocabulary = std::move(vocabulary);
   session.mapping.loop_closing = options.loop_closing;
+  if (options.triangulation_search) {
+    session.mapping.mapper.triangulation_search =
+        *parseTriangulationSearch(*options.triangulation_search);
+  }
   edge.embedded = std::make_unique<EmbeddedEdge>(session, link);
   edge.address = edge.embedded->clientAddress();
   spdlog::info("edge server on loopback, client connects to {}{}", edge.address,
@@ -102,7 +106,7 @@ EdgeEndpoint openEdge(const RunOptions& options, std::shared_ptr<const Vocabular
 }
 
 SessionConfig sessionConfig(const PinholeCamera& camera, Sensor sensor,
-                            const SlamOptions& slam_options, bool semantic) {
+                            const SlamOptions& slam_options, const RunOptions& options) {
   SessionConfig config;
   config.client_name = "edgeslam-client";
   config.camera = camera;
@@ -110,7 +114,8 @@ SessionConfig sessionConfig(const PinholeCamera& camera, Sensor sensor,
   config.settings.features = slam_options.orb.num_features;
   config.settings.pyramid_levels = slam_options.orb.num_levels;
   config.settings.scale_factor = slam_options.orb.scale_factor;
-  config.settings.semantic = semantic;
+  config.settings.semantic = options.semantic;
+  config.settings.client_map_keyframes = options.client_map_keyframes;
   return config;
 }
 
@@ -119,7 +124,7 @@ std::unique_ptr<SlamSystem> makeSlamSystem(const RunOptions& options, const std:
                                            const SlamOptions& slam_options,
                                            const EdgeEndpoint& edge) {
   if (mode == "local") return std::make_unique<LocalSlam>(camera, slam_options);
-  const SessionConfig config = sessionConfig(camera, sensor, slam_options, options.semantic);
+  const SessionConfig config = sessionConfig(camera, sensor, slam_options, options);
   if (mode == "offload") {
     return std::make_unique<OffloadSlam>(sensor,
                                          std::make_unique<EdgeClient>(edge.address, config));
@@ -169,6 +174,10 @@ int runPipeline(const RunOptions& options) {
   slam_options.tracker.vocabulary = loadVocabulary(options.vocabulary);
   slam_options.vocabulary = slam_options.tracker.vocabulary;
   slam_options.loop_closing = options.loop_closing;
+  if (options.triangulation_search) {
+    slam_options.mapper.triangulation_search =
+        *parseTriangulationSearch(*options.triangulation_search);
+  }
   slam_options.semantic = options.semantic;
   slam_options.keyframe_image_reduce = options.segment_reduce;
   if (options.semantic && options.server_address.empty()) {
@@ -296,6 +305,17 @@ int runPipeline(const RunOptions& options) {
          std::min<std::uint64_t>(counters.uplink_bytes, c.probe_uplink_bytes)) /
         keyframes_uploaded;
   }
+  if (const auto* edge_slam = dynamic_cast<const EdgeSlam*>(&slam)) {
+    // The client's own map; keyframes / map_points above are the edge's global map.
+    const ClientMapSize c = edge_slam->clientMapSize();
+    metrics["client_map"] = {{"window_keyframes", options.client_map_keyframes},
+                             {"keyframes", c.keyframes},
+                             {"points", c.points},
+                             {"max_keyframes", c.max_keyframes},
+                             {"max_points", c.max_points},
+                             {"keyframes_evicted", c.keyframes_evicted},
+                             {"keyframes_entered", c.keyframes_entered}};
+  }
   if (options.semantic || semantic_eval) {
     nlohmann::json semantic = {{"enabled", options.semantic},
                                {"keyframes_segmented", counters.keyframes_segmented},
@@ -316,6 +336,13 @@ int runPipeline(const RunOptions& options) {
              seconds, static_cast<double>(frame_count) / std::max(seconds, 1e-9), tracked, lost);
   fmt::print("  map          {} keyframes, {} points, {} relocalisations, {} resets\n",
              slam.keyFrameCount(), slam.mapPointCount(), slam.relocalizations(), slam.mapResets());
+  if (const auto* edge_slam = dynamic_cast<const EdgeSlam*>(&slam)) {
+    const ClientMapSize c = edge_slam->clientMapSize();
+    fmt::print("  client map   {} keyframes, {} points held (at most {} / {}; window {})\n",
+               c.keyframes, c.points, c.max_keyframes, c.max_points,
+               options.client_map_keyframes > 0 ? std::to_string(options.client_map_keyframes)
+                                                : std::string("unbounded"));
+  }
   if (mode != "local") {
     fmt::print(
         "  edge         {} keyframes up, {} slices back, slice latency median {:.1f} ms p90 "
@@ -395,6 +422,12 @@ void addRunOptions(CLI::App* run, const std::shared_ptr<RunOptions>& options) {
   run->add_option("--vocab", options->vocabulary,
                   "Vocabulary file for relocalisation and loops (default: vocab/ next to the "
                   "binary or $EDGESLAM_VOCAB; none = without)");
+  run->add_option("--client-map-keyframes", options->client_map_keyframes,
+                  "Edge mode: the client keeps features and points of about N keyframes around "
+                  "its latest one (the edge picks them, evicting the rest; relocalisation then "
+                  "searches these only); 0 = the whole map")
+      ->check(CLI::Range(0, 100000))
+      ->capture_default_str();
   run->add_option("--loops", options->loop_closing, "Loop closing on|off (needs a vocabulary)")
       ->transform(
           CLI::CheckedTransformer(std::map<std::string, bool>{{"on", true}, {"off", false}}));
@@ -414,6 +447,11 @@ void addRunOptions(CLI::App* run, const std::shared_ptr<RunOptions>& options) {
   run->add_option("--starving", options->starving,
                   "Tracked ratio below which keyframe rule 1 is waived (tracking starves)")
       ->check(CLI::Range(0.0, 1.0));
+  run->add_option("--triangulation-search", options->triangulation_search,
+                  "Local mapping's new-point search: bow (direct index, needs a vocabulary) or "
+                  "band (whole epipolar band); default bow")
+      ->check(CLI::IsMember({"bow", "band"}))
+      ->group("Advanced");
 }
 
 void addRunCommand(CLI::App& app) {

@@ -29,11 +29,16 @@ struct RunOptions {
   // binary (vocab/orb_k10_l5.vocab) when present, "none" = without.
   std::string vocabulary;
   bool loop_closing = true;
+  // Edge mode: the client holds the features and points of about this many keyframes around its
+  // latest one (the edge picks them and evicts the rest); 0 = the whole map.
+  int client_map_keyframes = 10;
   // Tuning; unset values keep the defaults (Table I row 1 for local tracking).
   std::optional<int> features;
   std::optional<int> levels;
   std::optional<int> fmin, fmax;
   std::optional<double> alpha, beta, starving;
+  // Local mapping's new-point search: "bow" or "band"; unset = LocalMapperOptions' default.
+  std::optional<std::string> triangulation_search;
 };
 
 }  // namespace edgeslam::cli

@@ -31,6 +31,11 @@ void KeyFramePlaces::add(const KeyFrame& keyframe) {
   direct_index_[keyframe.id()] = std::move(indexed.direct);
 }
 
+void KeyFramePlaces::erase(KeyFrameId id) {
+  database_.erase(id);
+  direct_index_.erase(id);
+}
+
 void KeyFramePlaces::clear() {
   database_.clear();
   direct_index_.clear();

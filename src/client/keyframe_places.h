@@ -19,7 +19,10 @@ class KeyFramePlaces {
   explicit KeyFramePlaces(std::shared_ptr<const Vocabulary> vocabulary);
 
   void add(const KeyFrame& keyframe);
+  // A keyframe the client no longer holds (evicted from its bounded map); no-op when unknown.
+  void erase(KeyFrameId id);
   void clear();
+  std::size_t size() const { return direct_index_.size(); }
 
   // Indexes a frame to look up, and returns the ids of the stored keyframes most similar to it,
   // best first, at most `max_results`, none scoring under `relative_min` times the best.

@@ -9,8 +9,20 @@ SliceApplyResult applySlice(Map& map, const MapSlice& slice, const PinholeCamera
   std::lock_guard lock(map.updateMutex());
   map.setChangeRecording(false);
   KeyFrameSet touched;
+  // Evictions first: the keyframes and points coming back below must not be dropped again.
+  for (KeyFrameId id : slice.keyframes_evicted) {
+    KeyFrame* kf = map.keyFrame(id);
+    if (kf == nullptr || kf->isEvicted()) continue;
+    const std::size_t points_before = map.pointCount();
+    map.evictKeyFrame(kf);
+    result.points_evicted += points_before - map.pointCount();
+    result.keyframes_evicted.push_back(id);
+  }
   for (const KeyFrameRecord& record : slice.keyframes) {
+    const KeyFrame* before = map.keyFrame(record.id);
+    const bool entering = before == nullptr || before->isEvicted();
     touched.insert(insertKeyFrameRecord(map, record, camera));
+    if (entering) result.keyframes_entered.push_back(record.id);
   }
   for (MapPointId id : slice.points_erased) {
     if (MapPoint* p = map.mapPoint(id)) {
@@ -44,11 +56,13 @@ SliceApplyResult applySlice(Map& map, const MapSlice& slice, const PinholeCamera
     }
   }
   for (KeyFrame* kf : touched) {
-    if (kf != nullptr && !kf->isBad()) map.updateConnections(kf);
+    if (kf != nullptr && !kf->isBad() && !kf->isEvicted()) map.updateConnections(kf);
   }
   if (const KeyFrame* processed = map.keyFrame(slice.processed_keyframe)) {
     result.frame_index = processed->frameIndex();
   }
+  result.keyframes_held = map.heldKeyFrameCount();
+  result.points_held = map.pointCount();
   map.setChangeRecording(true);
   return result;
 }

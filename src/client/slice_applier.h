@@ -1,8 +1,12 @@
 #pragma once
 // Applies the edge's map slices to the client's map: erased points and keyframes go, created and
 // corrected points are written with their observations among the client's keyframes, keyframe
-// poses take the edge's optimised values. Takes the map's update mutex for the duration.
+// poses take the edge's optimised values. With a bounded client map, the keyframes the edge
+// evicts keep only their poses (their observations go, and the points no held keyframe sees),
+// and keyframes back in the window get their features and points again; records naming what the
+// client does not hold are ignored. Takes the map's update mutex for the duration.
 #include <cstddef>
+#include <vector>
 
 #include "geometry/camera.h"
 #include "map/map.h"
@@ -17,6 +21,12 @@ struct SliceApplyResult {
   std::size_t keyframes_moved = 0;
   std::size_t keyframes_erased = 0;
   std::size_t frame_index = 0;  // of the processed keyframe, 0 when the client does not have it
+  std::vector<KeyFrameId> keyframes_evicted;  // held before, evicted now
+  std::vector<KeyFrameId> keyframes_entered;  // held now, not (or evicted) before
+  std::size_t points_evicted = 0;             // erased because only evicted keyframes saw them
+  // The client's map after the slice: keyframes held (not evicted) and points.
+  std::size_t keyframes_held = 0;
+  std::size_t points_held = 0;
 };
 
 SliceApplyResult applySlice(Map& map, const MapSlice& slice, const PinholeCamera& camera);

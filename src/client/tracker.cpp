@@ -36,6 +36,22 @@ void Tracker::remember(KeyFrame* keyframe) {
   if (places_ && keyframe != nullptr) places_->add(*keyframe);
 }
 
+void Tracker::onMapWindowChanged(const std::vector<KeyFrameId>& evicted,
+                                 const std::vector<KeyFrameId>& entered) {
+  std::lock_guard lock(map_.updateMutex());
+  if (!places_) return;
+  for (KeyFrameId id : evicted) places_->erase(id);
+  for (KeyFrameId id : entered) {
+    KeyFrame* kf = map_.keyFrame(id);
+    if (kf != nullptr && !kf->isBad() && !kf->isEvicted()) places_->add(*kf);
+  }
+}
+
+std::size_t Tracker::placesSize() const {
+  std::lock_guard lock(map_.updateMutex());
+  return places_ ? places_->size() : 0;
+}
+
 TrackResult Tracker::track(std::size_t frame_index, double timestamp,
                            std::shared_ptr<const FrameFeatures> features) {
   Frame frame(frame_index, timestamp, std::move(features), &camera_);
@@ -252,7 +268,10 @@ bool Tracker::trackWithMotionModel(Frame& frame) {
 }
 
 bool Tracker::trackReferenceKeyFrame(Frame& frame) {
-  if (reference_keyframe_ == nullptr || reference_keyframe_->isBad() || !last_frame_) return false;
+  if (reference_keyframe_ == nullptr || reference_keyframe_->isBad() ||
+      reference_keyframe_->isEvicted() || !last_frame_) {
+    return false;
+  }
   std::fill(frame.points.begin(), frame.points.end(), nullptr);
   const int matches = matchKeyFrameByDescriptor(*reference_keyframe_, frame);
   spdlog::debug("frame {}: reference keyframe matches {}", frame.index, matches);
@@ -265,7 +284,8 @@ bool Tracker::trackReferenceKeyFrame(Frame& frame) {
 std::vector<KeyFrame*> Tracker::relocalizationCandidates(const Frame& frame) {
   std::vector<KeyFrame*> candidates;
   const auto add = [&](KeyFrame* kf) {
-    if (kf != nullptr && !kf->isBad() &&
+    // Evicted keyframes (bounded client map) have no features or points to match.
+    if (kf != nullptr && !kf->isBad() && !kf->isEvicted() &&
         std::find(candidates.begin(), candidates.end(), kf) == candidates.end()) {
       candidates.push_back(kf);
     }
@@ -365,7 +385,8 @@ void Tracker::updateLocalMap(const Frame& frame) {
        ++k) {
     KeyFrame* kf = local_keyframes_[k];
     auto consider = [&](KeyFrame* other) {
-      if (other == nullptr || other->isBad() || other->track_reference_for_frame == frame.index) {
+      if (other == nullptr || other->isBad() || other->isEvicted() ||
+          other->track_reference_for_frame == frame.index) {
         return false;
       }
       other->track_reference_for_frame = frame.index;

@@ -58,6 +58,13 @@ class Tracker {
     SE3d T_cw;  // the pose estimated at the frame's time
   };
   const std::vector<FrameRecord>& records() const { return records_; }
+  // The edge moved the client's bounded map window: evicted keyframes leave the relocalisation
+  // database and keyframes back in the window join it again, so relocalisation searches the
+  // window only. Takes the map's update mutex (call from any thread, not inside track()).
+  void onMapWindowChanged(const std::vector<KeyFrameId>& evicted,
+                          const std::vector<KeyFrameId>& entered);
+  // Keyframes in the relocalisation database (0 without a vocabulary).
+  std::size_t placesSize() const;
   std::size_t relocalizations() const { return relocalizations_; }
   std::size_t resets() const { return resets_; }
 

@@ -18,8 +18,11 @@ EdgeMapSession::EdgeMapSession(const PinholeCamera& camera, Sensor sensor,
       mask_downscale_(std::max(1, options.mask_downscale)),
       movable_point_erode_px_(options.movable_point_erode_px),
       publish_(std::move(publish)),
-      threaded_(options.threaded) {
+      threaded_(options.threaded),
+      window_(options.window) {
   options.mapper.monocular = sensor == Sensor::kMonocular;
+  // The session's vocabulary serves the mapper's bag-of-words triangulation search too.
+  if (!options.mapper.vocabulary) options.mapper.vocabulary = options.vocabulary;
   mapper_ = std::make_unique<LocalMapper>(map_, camera_, options.mapper);
   if (options.vocabulary != nullptr && options.loop_closing) {
     LoopCloserOptions loop = loopCloserOptionsFor(sensor);
@@ -68,6 +71,8 @@ void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
       mapper_->onMapReset();
       if (loop_closer_) loop_closer_->onMapReset();
       map_.clear();
+      window_.clear();
+      window_centre_ = kInvalidId;
     }
     // The client already has what it sent: apply it without recording it for the slices.
     map_.setChangeRecording(false);
@@ -84,6 +89,7 @@ void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
       throw;
     }
     map_.setChangeRecording(true);
+    window_.clientHolds(keyframe->id());
     std::lock_guard state(state_mutex_);
     ++stats_.uploads;
     upload_of_keyframe_[keyframe->id()] = upload.sequence;
@@ -119,6 +125,12 @@ void EdgeMapSession::publishSlice(KeyFrame* mapped) {
       return;
     }
     slice = buildSlice(map_, map_.takeChanges());
+    if (mapped != nullptr && !mapped->isBad()) window_centre_ = mapped->id();
+    // Loop corrections and global BA keep the window of the last mapped keyframe.
+    const std::size_t entering_before = slice.keyframes.size();
+    window_.shape(map_, map_.keyFrame(window_centre_), slice);
+    slice.map_keyframes = map_.keyFrameCount();
+    slice.map_points = map_.pointCount();
     slice.masks = std::move(masks);
     if (mapped != nullptr) {
       slice.processed_keyframe = mapped->id();
@@ -143,6 +155,11 @@ void EdgeMapSession::publishSlice(KeyFrame* mapped) {
     }
     slice.newest_keyframe = newest_keyframe_;
     ++stats_.slices;
+    if (window_.bounded()) {
+      stats_.client_keyframes_held = window_.held().size();
+      stats_.client_keyframes_evicted += slice.keyframes_evicted.size();
+      stats_.client_keyframes_resent += slice.keyframes.size() - entering_before;
+    }
     stats_.keyframes = map_.keyFrameCount();
     stats_.map_points = map_.pointCount();
   }

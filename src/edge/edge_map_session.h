@@ -9,6 +9,7 @@
 #include <mutex>
 #include <unordered_map>
 
+#include "edge/client_map_window.h"
 #include "edge/keyframe_segmentation.h"
 #include "edge/local_mapper.h"
 #include "edge/loop_closer.h"
@@ -29,6 +30,8 @@ struct EdgeMapSessionOptions {
   std::shared_ptr<Segmenter> segmenter;
   int mask_downscale = 4;  // the label image travels at 1/this of the camera's resolution
   int movable_point_erode_px = 2;
+  // The client's bounded map (window.keyframes = 0: it replicates the whole global map).
+  ClientMapWindowOptions window;
 };
 
 struct EdgeMapSessionStats {
@@ -38,6 +41,9 @@ struct EdgeMapSessionStats {
   std::uint64_t map_points = 0;
   std::uint64_t keyframes_segmented = 0;
   std::uint64_t movable_points_erased = 0;
+  std::uint64_t client_keyframes_held = 0;  // bounded client map: as the edge counts them
+  std::uint64_t client_keyframes_evicted = 0;
+  std::uint64_t client_keyframes_resent = 0;  // sent back into the window
 };
 
 class EdgeMapSession {
@@ -59,6 +65,8 @@ class EdgeMapSession {
 
   EdgeMapSessionStats stats() const;
   Map& map() { return map_; }
+  // The keyframes the client holds (lock the map's update mutex while reading).
+  const ClientMapWindow& clientWindow() const { return window_; }
   // nullptr without a vocabulary or with loop closing off.
   const LoopCloser* loopCloser() const { return loop_closer_.get(); }
   // nullptr without segmentation.
@@ -80,6 +88,8 @@ class EdgeMapSession {
   int movable_point_erode_px_;
   Publish publish_;
   bool threaded_;
+  ClientMapWindow window_;                 // guarded by the map's update mutex
+  KeyFrameId window_centre_ = kInvalidId;  // the last keyframe mapped
 
   // Mapping and loop closing publish from their own threads: slices leave in sequence order.
   std::mutex publish_mutex_;

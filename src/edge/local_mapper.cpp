@@ -3,6 +3,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "geometry/chi_square.h"
@@ -11,11 +12,30 @@
 
 namespace edgeslam {
 
+std::string_view toString(TriangulationSearch search) {
+  return search == TriangulationSearch::kBagOfWords ? "bow" : "band";
+}
+
+std::optional<TriangulationSearch> parseTriangulationSearch(std::string_view text) {
+  if (text == "bow") return TriangulationSearch::kBagOfWords;
+  if (text == "band") return TriangulationSearch::kEpipolarBand;
+  return std::nullopt;
+}
+
 LocalMapper::LocalMapper(Map& map, const PinholeCamera& camera, LocalMapperOptions options)
-    : map_(map), camera_(camera), options_(options) {}
+    : map_(map), camera_(camera), options_(std::move(options)) {}
 
 LocalMapper::~LocalMapper() {
   stop();
+  const LocalMapperStats s = stats();
+  if (s.triangulation_searches > 0) {
+    spdlog::info(
+        "local mapping: {} triangulation searches ({} by bag of words), {} pairs, {:.2f} ms per "
+        "search, {} points created",
+        s.triangulation_searches, s.triangulation_bow_searches, s.triangulation_pairs,
+        s.triangulation_search_ms / static_cast<double>(s.triangulation_searches),
+        s.points_created);
+  }
 }
 
 void LocalMapper::start() {
@@ -130,8 +150,31 @@ void LocalMapper::processKeyFrame(KeyFrame* keyframe) {
   if (on_mapped_) on_mapped_(keyframe);
 }
 
+bool LocalMapper::searchesByBow() const {
+  return options_.triangulation_search == TriangulationSearch::kBagOfWords &&
+         options_.vocabulary != nullptr && !options_.vocabulary->empty();
+}
+
+void LocalMapper::describe(KeyFrame* keyframe) const {
+  if (!searchesByBow()) return;
+  if (const auto place = keyframe->place();
+      place != nullptr && place->direct_index_depth == options_.direct_index_depth &&
+      place->vocabulary == options_.vocabulary.get()) {
+    return;
+  }
+  // The features never change: no lock needed.
+  auto place = std::make_shared<KeyFramePlace>();
+  place->direct_index_depth = options_.direct_index_depth;
+  place->vocabulary = options_.vocabulary.get();
+  const int levels_up = std::max(0, options_.vocabulary->levels() - options_.direct_index_depth);
+  options_.vocabulary->transform(keyframe->features().descriptors, levels_up, place->bow,
+                                 place->features);
+  keyframe->setPlace(std::move(place));
+}
+
 void LocalMapper::mapKeyFrame(KeyFrame* keyframe) {
   if (reset_requested_.exchange(false)) recent_points_.clear();
+  describe(keyframe);
   {
     std::lock_guard lock(map_.updateMutex());
     if (keyframe->isBad()) return;
@@ -212,6 +255,11 @@ void LocalMapper::createNewPoints(KeyFrame* keyframe) {
     neighbours = keyframe->bestCovisibles(mono ? options_.triangulation_neighbours_mono
                                                : options_.triangulation_neighbours_depth);
   }
+  // Neighbours normally were described when they were mapped; keyframes made before the
+  // vocabulary was given are described now.
+  for (KeyFrame* neighbour : neighbours) describe(neighbour);
+  std::size_t searches = 0, bow_searches = 0, proposed = 0;
+  double search_ms = 0.0;
   const FrameFeatures& f1 = keyframe->features();
   const ScaleLevels& scales = f1.scales;
   const double ratio_factor = 1.5 * scales.scaleFactor();
@@ -232,8 +280,18 @@ void LocalMapper::createNewPoints(KeyFrame* keyframe) {
     } else if (f1.bf > 0.f && baseline < f1.bf / camera_.fx()) {
       continue;
     }
-    const auto pairs =
-        matchForTriangulation(*keyframe, *neighbour, camera_, mono, options_.triangulation_ratio);
+    const auto search_start = std::chrono::steady_clock::now();
+    const bool by_bow = searchesByBow() && canMatchForTriangulationByBow(*keyframe, *neighbour);
+    const auto pairs = by_bow ? matchForTriangulationByBow(*keyframe, *neighbour, camera_, mono,
+                                                           options_.triangulation_ratio)
+                              : matchForTriangulation(*keyframe, *neighbour, camera_, mono,
+                                                      options_.triangulation_ratio);
+    search_ms +=
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - search_start)
+            .count();
+    ++searches;
+    bow_searches += by_bow ? 1 : 0;
+    proposed += pairs.size();
     const FrameFeatures& f2 = neighbour->features();
     for (const auto& [i1, i2] : pairs) {
       if (keyframe->point(i1) != nullptr || neighbour->point(i2) != nullptr) continue;
@@ -284,10 +342,14 @@ void LocalMapper::createNewPoints(KeyFrame* keyframe) {
       ++created;
     }
   }
-  spdlog::debug("keyframe {} (frame {}): {} new points from {} neighbours", keyframe->id(),
-                keyframe->frameIndex(), created, neighbours.size());
+  spdlog::debug("keyframe {} (frame {}): {} new points from {} pairs with {} neighbours",
+                keyframe->id(), keyframe->frameIndex(), created, proposed, neighbours.size());
   std::lock_guard lock(stats_mutex_);
   stats_.points_created += created;
+  stats_.triangulation_searches += searches;
+  stats_.triangulation_bow_searches += bow_searches;
+  stats_.triangulation_pairs += proposed;
+  stats_.triangulation_search_ms += search_ms;
 }
 
 void LocalMapper::fuseWithNeighbours(KeyFrame* keyframe) {

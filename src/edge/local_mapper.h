@@ -9,15 +9,28 @@
 #include <deque>
 #include <functional>
 #include <list>
+#include <memory>
 #include <mutex>
+#include <optional>
+#include <string_view>
 #include <thread>
 
 #include "geometry/camera.h"
 #include "map/keyframe_sink.h"
 #include "map/map.h"
 #include "optimize/map_optimization.h"
+#include "place/vocabulary.h"
 
 namespace edgeslam {
+
+// How triangulation finds keypoint pairs between a keyframe and its neighbours: through their
+// bag-of-words direct indexes (map_matching.h matchForTriangulationByBow), or every unmatched
+// keypoint against the whole epipolar band (matchForTriangulation).
+enum class TriangulationSearch { kBagOfWords, kEpipolarBand };
+
+std::string_view toString(TriangulationSearch search);
+// "bow" or "band"; nullopt otherwise.
+std::optional<TriangulationSearch> parseTriangulationSearch(std::string_view text);
 
 struct LocalMapperOptions {
   bool monocular = true;
@@ -27,6 +40,13 @@ struct LocalMapperOptions {
   std::size_t fusion_neighbours_depth = 10;
   // Best/second-best ratio of the epipolar descriptor search.
   float triangulation_ratio = 0.6f;
+  // kBagOfWords needs `vocabulary`; without one the band search is used.
+  TriangulationSearch triangulation_search = TriangulationSearch::kBagOfWords;
+  // With kBagOfWords, every keyframe is described (bag of words and direct index at
+  // `direct_index_depth`, stored on the KeyFrame, where loop closing finds it) before
+  // triangulation.
+  std::shared_ptr<const Vocabulary> vocabulary;
+  int direct_index_depth = 2;    // as loop detection's, so that its description is reused
   std::size_t max_queue = 3;     // tracking is asked to wait beyond this backlog
   double redundant_ratio = 0.9;  // a keyframe whose points are 90 % seen by 3+ others is culled
   bool run_local_ba = true;
@@ -43,6 +63,12 @@ struct LocalMapperStats {
   std::size_t points_culled = 0;
   std::size_t keyframes_culled = 0;
   std::size_t local_ba_runs = 0;
+  // Triangulation searches (and how many went through bag of words), the pairs they proposed and
+  // their total wall time.
+  std::size_t triangulation_searches = 0;
+  std::size_t triangulation_bow_searches = 0;
+  std::size_t triangulation_pairs = 0;
+  double triangulation_search_ms = 0.0;
 };
 
 class LocalMapper : public KeyFrameSink {
@@ -80,6 +106,8 @@ class LocalMapper : public KeyFrameSink {
   void linkKeyFrame(KeyFrame* keyframe);
   void observeRecentPoints(KeyFrame* keyframe);
   void cullRecentPoints(KeyFrame* keyframe);
+  void describe(KeyFrame* keyframe) const;
+  bool searchesByBow() const;
   void createNewPoints(KeyFrame* keyframe);
   void fuseWithNeighbours(KeyFrame* keyframe);
   void cullKeyFrames(KeyFrame* keyframe);

@@ -24,8 +24,15 @@ const KeyFrameBow& LoopDetector::describe(const KeyFrame& keyframe) {
     if (const auto it = bows_.find(keyframe.id()); it != bows_.end()) return it->second;
   }
   KeyFrameBow bow;
-  const int levels_up = std::max(0, vocabulary_->levels() - options_.direct_index_depth);
-  vocabulary_->transform(keyframe.features().descriptors, levels_up, bow.bow, bow.features);
+  if (const auto place = keyframe.place();
+      place != nullptr && place->vocabulary == vocabulary_.get() &&
+      place->direct_index_depth == options_.direct_index_depth) {
+    bow.bow = place->bow;  // local mapping described it already
+    bow.features = place->features;
+  } else {
+    const int levels_up = std::max(0, vocabulary_->levels() - options_.direct_index_depth);
+    vocabulary_->transform(keyframe.features().descriptors, levels_up, bow.bow, bow.features);
+  }
   std::lock_guard lock(bow_mutex_);
   return bows_.try_emplace(keyframe.id(), std::move(bow)).first->second;
 }

@@ -1,6 +1,7 @@
 #pragma once
 // A keyframe: a frame's features kept in the map, its pose, the points it observes and its place in
 // the covisibility graph and spanning tree. Mutated only through Map (under its update mutex).
+#include <atomic>
 #include <map>
 #include <memory>
 #include <set>
@@ -9,6 +10,8 @@
 #include "features/frame_features.h"
 #include "geometry/se3.h"
 #include "map/ids.h"
+#include "place/bow_vector.h"
+#include "place/feature_vector.h"
 
 namespace edgeslam {
 
@@ -20,6 +23,17 @@ struct KeyFrameIdLess {
   bool operator()(const KeyFrame* a, const KeyFrame* b) const;
 };
 using KeyFrameSet = std::set<KeyFrame*, KeyFrameIdLess>;
+
+class Vocabulary;
+
+// A keyframe's bag of words and direct index (features filed under their vocabulary node at
+// `direct_index_depth`), computed once from the session's vocabulary.
+struct KeyFramePlace {
+  BowVector bow;
+  FeatureVector features;
+  int direct_index_depth = 0;
+  const Vocabulary* vocabulary = nullptr;  // which one, to compare only; not owned
+};
 
 class KeyFrame {
  public:
@@ -60,6 +74,14 @@ class KeyFrame {
   const KeyFrameSet& loopEdges() const { return loop_edges_; }
   bool isBad() const { return bad_; }
   bool isProtected() const { return protected_from_culling_; }
+  // A replica's keyframe outside the part of the map it holds: id, pose and spanning-tree place
+  // only; no features, points or covisibility (Map::evictKeyFrame).
+  bool isEvicted() const { return evicted_; }
+
+  // Set once (by local mapping, when it has a vocabulary) and then read-only; safe from any
+  // thread. nullptr until then. Describes the features the keyframe had when it was set.
+  std::shared_ptr<const KeyFramePlace> place() const { return place_.load(); }
+  void setPlace(std::shared_ptr<const KeyFramePlace> place) { place_.store(std::move(place)); }
 
   // Tracking / mapping scratch state.
   std::size_t track_reference_for_frame = static_cast<std::size_t>(-1);
@@ -74,6 +96,7 @@ class KeyFrame {
   std::size_t frame_index_;
   double timestamp_;
   std::shared_ptr<const FrameFeatures> features_;
+  std::atomic<std::shared_ptr<const KeyFramePlace>> place_;
   SE3d T_cw_;
   SE3d T_wc_;
   std::vector<MapPoint*> points_;
@@ -84,6 +107,7 @@ class KeyFrame {
   KeyFrameSet loop_edges_;
   bool first_connection_ = true;
   bool bad_ = false;
+  bool evicted_ = false;
   bool protected_from_culling_ = false;
   SE3d T_cp_;  // camera-from-parent, frozen when the keyframe is erased
 };

@@ -74,6 +74,25 @@ void Map::eraseObservation(MapPoint* point, KeyFrame* keyframe) {
   }
 }
 
+void Map::detachObservation(MapPoint* point, KeyFrame* keyframe) {
+  const auto it = point->observations_.find(keyframe->id());
+  if (it == point->observations_.end()) return;
+  const std::size_t index = it->second.index;
+  point->observation_weight_ -= keyframe->features().hasDepth(index) ? 2 : 1;
+  point->observations_.erase(it);
+  if (index < keyframe->points_.size() && keyframe->points_[index] == point) {
+    keyframe->points_[index] = nullptr;
+  }
+  if (point->observations_.empty()) {
+    erasePoint(point);
+    return;
+  }
+  if (point->reference_keyframe_ == keyframe) {
+    point->reference_keyframe_ = point->observations_.begin()->second.keyframe;
+  }
+  record().pointUpdated(point->id());
+}
+
 void Map::erasePoint(MapPoint* point) {
   if (point->bad_) return;
   point->bad_ = true;
@@ -151,8 +170,7 @@ void Map::updateConnections(KeyFrame* keyframe) {
   record().keyFrameUpdated(keyframe->id());
 }
 
-void Map::eraseKeyFrame(KeyFrame* keyframe) {
-  if (keyframe->bad_ || keyframe == origin_ || keyframe->protected_from_culling_) return;
+void Map::unlinkConnections(KeyFrame* keyframe) {
   for (auto& [kf, w] : keyframe->connection_weights_) {
     kf->connection_weights_.erase(keyframe);
     auto& theirs = kf->ordered_connections_;
@@ -162,6 +180,35 @@ void Map::eraseKeyFrame(KeyFrame* keyframe) {
   }
   keyframe->connection_weights_.clear();
   keyframe->ordered_connections_.clear();
+}
+
+void Map::evictKeyFrame(KeyFrame* keyframe) {
+  if (keyframe->bad_ || keyframe->evicted_) return;
+  unlinkConnections(keyframe);
+  for (std::size_t i = 0; i < keyframe->points_.size(); ++i) {
+    // Not eraseObservation: a point the replica still sees once stays (the owner culls points).
+    if (MapPoint* p = keyframe->points_[i]) detachObservation(p, keyframe);
+  }
+  auto empty = std::make_shared<FrameFeatures>();
+  empty->scales = keyframe->features_->scales;
+  empty->bf = keyframe->features_->bf;
+  keyframe->features_ = std::move(empty);
+  keyframe->points_.clear();
+  keyframe->evicted_ = true;
+  ++evicted_keyframes_;
+}
+
+void Map::restoreKeyFrame(KeyFrame* keyframe, std::shared_ptr<const FrameFeatures> features) {
+  if (keyframe->bad_ || !keyframe->evicted_) return;
+  keyframe->features_ = std::move(features);
+  keyframe->points_.assign(keyframe->features_->size(), nullptr);
+  keyframe->evicted_ = false;
+  --evicted_keyframes_;
+}
+
+void Map::eraseKeyFrame(KeyFrame* keyframe) {
+  if (keyframe->bad_ || keyframe == origin_ || keyframe->protected_from_culling_) return;
+  unlinkConnections(keyframe);
   for (std::size_t i = 0; i < keyframe->points_.size(); ++i) {
     if (MapPoint* p = keyframe->points_[i]) eraseObservation(p, keyframe);
   }
@@ -203,6 +250,7 @@ void Map::eraseKeyFrame(KeyFrame* keyframe) {
   }
   keyframe->children_.clear();
   keyframe->bad_ = true;
+  if (keyframe->evicted_) --evicted_keyframes_;
   record().keyFrameErased(keyframe->id());
   auto node = keyframes_.extract(keyframe->id());
   if (!node.empty()) retired_keyframes_.push_back(std::move(node.mapped()));
@@ -229,6 +277,7 @@ void Map::clear() {
   points_.clear();
   keyframes_.clear();
   origin_ = nullptr;
+  evicted_keyframes_ = 0;
   changes_.clear();
 }
 

@@ -36,6 +36,9 @@ class Map {
   void addObservation(MapPoint* point, KeyFrame* keyframe, std::size_t index);
   // Unlinks; a point left with fewer than two observations is erased.
   void eraseObservation(MapPoint* point, KeyFrame* keyframe);
+  // Unlinks without that cull, erasing the point only when no observation is left: a replica
+  // mirroring the other side, which culls for itself.
+  void detachObservation(MapPoint* point, KeyFrame* keyframe);
   void erasePoint(MapPoint* point);
   // Moves every observation of `old_point` to `replacement` (point fusion) and erases `old_point`.
   void replacePoint(MapPoint* old_point, MapPoint* replacement);
@@ -55,11 +58,20 @@ class Map {
   // children.
   void eraseKeyFrame(KeyFrame* keyframe);
   void addLoopEdge(KeyFrame* a, KeyFrame* b);
+  // A replica bounding what it holds: the keyframe keeps its id, pose and spanning-tree links (so
+  // poses relative to it still follow corrections) but drops its features, its observations and
+  // its covisibility links; points left without any observation are erased. No-op when bad or
+  // already evicted.
+  void evictKeyFrame(KeyFrame* keyframe);
+  // Gives an evicted keyframe its features back (no points yet: the caller links them).
+  void restoreKeyFrame(KeyFrame* keyframe, std::shared_ptr<const FrameFeatures> features);
   // Empties the map (a failed start); ids keep counting up.
   void clear();
   void protectKeyFrame(KeyFrame* keyframe) { keyframe->protected_from_culling_ = true; }
 
   std::size_t keyFrameCount() const { return keyframes_.size(); }
+  // Keyframes that are not evicted (with their features and points).
+  std::size_t heldKeyFrameCount() const { return keyframes_.size() - evicted_keyframes_; }
   std::size_t pointCount() const { return points_.size(); }
   std::vector<KeyFrame*> keyFrames() const;  // sorted by id
   std::vector<MapPoint*> mapPoints() const;  // sorted by id
@@ -82,11 +94,13 @@ class Map {
   std::vector<std::unique_ptr<KeyFrame>> retired_keyframes_;
   std::vector<std::unique_ptr<MapPoint>> retired_points_;
   KeyFrame* origin_ = nullptr;
+  std::size_t evicted_keyframes_ = 0;  // live (not erased) keyframes that are evicted
   MapChanges changes_;
   MapChanges ignored_changes_;
   bool recording_ = true;
 
   MapChanges& record();
+  void unlinkConnections(KeyFrame* keyframe);  // covisibility links, both ways
 };
 
 }  // namespace edgeslam

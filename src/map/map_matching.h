@@ -69,14 +69,28 @@ int matchKeyFrameByProjection(Frame& frame, const KeyFrame& keyframe,
 // are skipped, unless `monocular` is false and either keypoint has sensor depth. The ratio test
 // compares the best and second best kf2 keypoint inside the epipolar band (0.6 keeps ~93 % correct
 // pairs on 7-Scenes; 0.8 gives ~60 % more pairs at ~90 %). At most one pair per kf2 keypoint (the
-// closest descriptor). Until bag-of-words arrives every unmatched kf1 keypoint is tested against
-// the band of kf2's unmatched keypoints (about 1.5 ms for 1000 x 1000). Returns (index in kf1,
+// closest descriptor). Every unmatched kf1 keypoint is tested against the band of kf2's unmatched
+// keypoints (about 1.5 ms for 1000 x 1000). Returns (index in kf1,
 // index in kf2) pairs, sorted.
 std::vector<std::pair<std::size_t, std::size_t>> matchForTriangulation(const KeyFrame& kf1,
                                                                        const KeyFrame& kf2,
                                                                        const PinholeCamera& camera,
                                                                        bool monocular,
                                                                        float ratio = 0.6f);
+
+// The same search guided by bag of words: candidate pairs only between keypoints filed under the
+// same node of the two keyframes' direct indexes (KeyFrame::place()), then the same checks
+// (unmatched on both sides, Hamming <= kMatchDistanceLow, epipolar band, epipole rule, ratio
+// against the second best candidate of the node inside the band, one pair per kf2 keypoint,
+// rotation check). Compares a few keypoints per node instead of the whole band; misses pairs whose
+// descriptors fall under different nodes. Falls back to matchForTriangulation when
+// canMatchForTriangulationByBow is false. Throws std::invalid_argument when a direct index names
+// a keypoint the keyframe does not have.
+std::vector<std::pair<std::size_t, std::size_t>> matchForTriangulationByBow(
+    const KeyFrame& kf1, const KeyFrame& kf2, const PinholeCamera& camera, bool monocular,
+    float ratio = 0.6f);
+// Both keyframes have a place, from the same vocabulary with direct indexes at the same depth.
+bool canMatchForTriangulationByBow(const KeyFrame& kf1, const KeyFrame& kf2);
 
 // Fusion of duplicated points: projects `points` into `keyframe` (skipping those it already
 // observes, outside their distance range or seen at more than 60 degrees from their normal),

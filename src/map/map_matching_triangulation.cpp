@@ -1,7 +1,7 @@
 // Search for new points between two keyframes: unmatched keypoints of kf1 against the unmatched
 // keypoints of kf2 that lie in the band around kf1's epipolar line. The band test (three
 // multiply-adds on packed arrays) comes first so that only a few per cent of the pairs reach the
-// descriptor distance.
+// descriptor distance. Also the geometry and bookkeeping shared with the bag-of-words variant.
 #include <Eigen/Core>
 #include <algorithm>
 #include <climits>
@@ -12,8 +12,10 @@
 #include "features/rotation_histogram.h"
 #include "map/map_matching.h"
 #include "map/map_matching_internal.h"
+#include "map/map_matching_triangulation_internal.h"
 
 namespace edgeslam {
+namespace triangulation_detail {
 namespace {
 
 constexpr float kEpipolarChi2 = 3.84f;  // chi-square, 1 degree of freedom, 95 %
@@ -26,41 +28,19 @@ Eigen::Matrix3d skew(const Eigen::Vector3d& v) {
   return m;
 }
 
-// kf2's unmatched keypoints, packed for the band test.
-struct Candidates {
-  std::vector<float> u, v, max_distance2;
-  std::vector<int> index;
-  std::vector<unsigned char> near_epipole;
-
-  void reserve(std::size_t n) {
-    u.reserve(n);
-    v.reserve(n);
-    max_distance2.reserve(n);
-    index.reserve(n);
-    near_epipole.reserve(n);
-  }
-};
-
 }  // namespace
 
-std::vector<std::pair<std::size_t, std::size_t>> matchForTriangulation(const KeyFrame& kf1,
-                                                                       const KeyFrame& kf2,
-                                                                       const PinholeCamera& camera,
-                                                                       bool monocular,
-                                                                       float ratio) {
-  std::vector<std::pair<std::size_t, std::size_t>> pairs;
-  if (kf1.size() == 0 || kf2.size() == 0) return pairs;
-  const FrameFeatures& f1 = kf1.features();
-  const FrameFeatures& f2 = kf2.features();
-
+TriangulationGeometry::TriangulationGeometry(const KeyFrame& kf1, const KeyFrame& kf2,
+                                             const PinholeCamera& camera, bool monocular) {
   // Relative pose 1 -> 2 and the fundamental matrix x2^T F21 x1 = 0.
   const Eigen::Matrix3d R1 = kf1.pose().rotationMatrix();
   const Eigen::Matrix3d R2 = kf2.pose().rotationMatrix();
   const Eigen::Matrix3d R21 = R2 * R1.transpose();
   const Eigen::Vector3d t21 = kf2.pose().translation() - R21 * kf1.pose().translation();
-  if (!(t21.norm() > 1e-9)) return pairs;  // no baseline: nothing can be triangulated
+  has_baseline_ = t21.norm() > 1e-9;
+  if (!has_baseline_) return;
   const Eigen::Matrix3d K_inv = camera.K().inverse();
-  const Eigen::Matrix3d F21 = K_inv.transpose() * skew(t21) * R21 * K_inv;
+  F21_ = K_inv.transpose() * skew(t21) * R21 * K_inv;
 
   // kf1's centre seen from kf2 (t21 is that point in kf2's frame).
   const bool has_epipole = std::abs(t21.z()) > 1e-9;
@@ -69,8 +49,9 @@ std::vector<std::pair<std::size_t, std::size_t>> matchForTriangulation(const Key
   const float epipole_v =
       has_epipole ? static_cast<float>(camera.fy() * t21.y() / t21.z() + camera.cy()) : 0.f;
 
-  Candidates candidates;
-  candidates.reserve(kf2.size());
+  const FrameFeatures& f2 = kf2.features();
+  candidacy_.assign(kf2.size(), Candidacy::kNone);
+  max_distance2_.assign(kf2.size(), 0.f);
   for (std::size_t j = 0; j < kf2.size(); ++j) {
     if (matching_detail::isUsable(kf2.point(j))) continue;
     const cv::KeyPoint& kp = f2.keypoints[j];
@@ -81,75 +62,97 @@ std::vector<std::pair<std::size_t, std::size_t>> matchForTriangulation(const Key
     // Depth from the sensor makes a point near the epipole well defined after all.
     const bool near_matters = near && (monocular || !f2.hasDepth(j));
     if (monocular && near_matters) continue;
-    candidates.u.push_back(kp.pt.x);
-    candidates.v.push_back(kp.pt.y);
-    candidates.max_distance2.push_back(kEpipolarChi2 *
-                                       static_cast<float>(f2.scales.sigma2(kp.octave)));
-    candidates.index.push_back(static_cast<int>(j));
-    candidates.near_epipole.push_back(near_matters ? 1 : 0);
+    candidacy_[j] = near_matters ? Candidacy::kNeedsDepthInKf1 : Candidacy::kAny;
+    max_distance2_[j] = kEpipolarChi2 * static_cast<float>(f2.scales.sigma2(kp.octave));
   }
-  const std::size_t m = candidates.index.size();
-  if (m == 0) return pairs;
+}
 
-  // One match per kf2 keypoint: the closest kf1 keypoint wins.
-  std::vector<int> owner(kf2.size(), -1);
-  std::vector<int> owner_distance(kf2.size(), INT_MAX);
-  const float* cu = candidates.u.data();
-  const float* cv_ = candidates.v.data();
-  const float* cmax = candidates.max_distance2.data();
-  for (std::size_t i = 0; i < kf1.size(); ++i) {
-    if (matching_detail::isUsable(kf1.point(i))) continue;
-    const cv::KeyPoint& kp1 = f1.keypoints[i];
-    const Eigen::Vector3d line = F21 * Eigen::Vector3d(kp1.pt.x, kp1.pt.y, 1.0);
-    const double norm = std::hypot(line.x(), line.y());
-    if (!(norm > 0.0)) continue;
-    // Normalised line: a*u + b*v + c is the signed pixel distance.
-    const float a = static_cast<float>(line.x() / norm);
-    const float b = static_cast<float>(line.y() / norm);
-    const float c = static_cast<float>(line.z() / norm);
-    const bool depth1 = f1.hasDepth(i);
-    const std::uint8_t* descriptor = f1.descriptors.ptr<std::uint8_t>(static_cast<int>(i));
+std::optional<EpipolarLine> TriangulationGeometry::lineOf(const cv::KeyPoint& kp1) const {
+  const Eigen::Vector3d line = F21_ * Eigen::Vector3d(kp1.pt.x, kp1.pt.y, 1.0);
+  const double norm = std::hypot(line.x(), line.y());
+  if (!(norm > 0.0)) return std::nullopt;
+  return EpipolarLine{static_cast<float>(line.x() / norm), static_cast<float>(line.y() / norm),
+                      static_cast<float>(line.z() / norm)};
+}
 
-    int best_distance = INT_MAX, second_distance = INT_MAX, best_k = -1;
-    for (std::size_t k = 0; k < m; ++k) {
-      const float d = a * cu[k] + b * cv_[k] + c;
-      if (d * d >= cmax[k]) continue;
-      if (candidates.near_epipole[k] && !depth1) continue;
-      const int distance =
-          descriptorDistance(descriptor, f2.descriptors.ptr<std::uint8_t>(candidates.index[k]));
-      if (distance < best_distance) {
-        second_distance = best_distance;
-        best_distance = distance;
-        best_k = static_cast<int>(k);
-      } else if (distance < second_distance) {
-        second_distance = distance;
-      }
-    }
-    if (best_k < 0 || best_distance > kMatchDistanceLow) continue;
-    if (second_distance != INT_MAX &&
-        static_cast<float>(best_distance) >= ratio * static_cast<float>(second_distance)) {
-      continue;
-    }
-    const auto j = static_cast<std::size_t>(candidates.index[static_cast<std::size_t>(best_k)]);
-    if (best_distance < owner_distance[j]) {
-      owner[j] = static_cast<int>(i);
-      owner_distance[j] = best_distance;
-    }
-  }
+bool passesDistanceAndRatio(const matching_detail::BestTwoWithLevels& best, float ratio) {
+  if (best.index < 0 || best.distance > kMatchDistanceLow) return false;
+  return best.second_distance == INT_MAX ||
+         static_cast<float>(best.distance) < ratio * static_cast<float>(best.second_distance);
+}
 
+Pairs OnePairPerKf2Keypoint::rotationConsistentPairs(const KeyFrame& kf1,
+                                                     const KeyFrame& kf2) const {
+  const FrameFeatures& f1 = kf1.features();
+  const FrameFeatures& f2 = kf2.features();
   RotationHistogram histogram;
-  for (std::size_t j = 0; j < kf2.size(); ++j) {
-    if (owner[j] >= 0) {
-      histogram.add(f1.keypoints[static_cast<std::size_t>(owner[j])].angle, f2.keypoints[j].angle,
+  for (std::size_t j = 0; j < owner_.size(); ++j) {
+    if (owner_[j] >= 0) {
+      histogram.add(f1.keypoints[static_cast<std::size_t>(owner_[j])].angle, f2.keypoints[j].angle,
                     static_cast<int>(j));
     }
   }
+  Pairs pairs;
   for (const int j : histogram.consistent()) {
-    pairs.emplace_back(static_cast<std::size_t>(owner[static_cast<std::size_t>(j)]),
+    pairs.emplace_back(static_cast<std::size_t>(owner_[static_cast<std::size_t>(j)]),
                        static_cast<std::size_t>(j));
   }
   std::sort(pairs.begin(), pairs.end());
   return pairs;
+}
+
+}  // namespace triangulation_detail
+
+std::vector<std::pair<std::size_t, std::size_t>> matchForTriangulation(const KeyFrame& kf1,
+                                                                       const KeyFrame& kf2,
+                                                                       const PinholeCamera& camera,
+                                                                       bool monocular,
+                                                                       float ratio) {
+  using namespace triangulation_detail;
+  if (kf1.size() == 0 || kf2.size() == 0) return {};
+  const TriangulationGeometry geometry(kf1, kf2, camera, monocular);
+  if (!geometry.hasBaseline()) return {};
+  const FrameFeatures& f1 = kf1.features();
+  const FrameFeatures& f2 = kf2.features();
+
+  // kf2's candidate keypoints, packed for the band test.
+  std::vector<float> cu, cv_, cmax;
+  std::vector<int> index;
+  std::vector<unsigned char> needs_depth;
+  for (std::size_t j = 0; j < kf2.size(); ++j) {
+    const Candidacy c = geometry.candidacy()[j];
+    if (c == Candidacy::kNone) continue;
+    cu.push_back(f2.keypoints[j].pt.x);
+    cv_.push_back(f2.keypoints[j].pt.y);
+    cmax.push_back(geometry.maxDistance2()[j]);
+    index.push_back(static_cast<int>(j));
+    needs_depth.push_back(c == Candidacy::kNeedsDepthInKf1 ? 1 : 0);
+  }
+  const std::size_t m = index.size();
+  if (m == 0) return {};
+
+  OnePairPerKf2Keypoint owners(kf2.size());
+  for (std::size_t i = 0; i < kf1.size(); ++i) {
+    if (matching_detail::isUsable(kf1.point(i))) continue;
+    const std::optional<EpipolarLine> line = geometry.lineOf(f1.keypoints[i]);
+    if (!line) continue;
+    const float a = line->a, b = line->b, c = line->c;
+    const bool depth1 = f1.hasDepth(i);
+    const std::uint8_t* descriptor = f1.descriptors.ptr<std::uint8_t>(static_cast<int>(i));
+
+    matching_detail::BestTwoWithLevels best;
+    for (std::size_t k = 0; k < m; ++k) {
+      const float d = a * cu[k] + b * cv_[k] + c;
+      if (d * d >= cmax[k]) continue;
+      if (needs_depth[k] && !depth1) continue;
+      best.consider(static_cast<int>(k),
+                    descriptorDistance(descriptor, f2.descriptors.ptr<std::uint8_t>(index[k])), 0);
+    }
+    if (!passesDistanceAndRatio(best, ratio)) continue;
+    owners.propose(i, static_cast<std::size_t>(index[static_cast<std::size_t>(best.index)]),
+                   best.distance);
+  }
+  return owners.rotationConsistentPairs(kf1, kf2);
 }
 
 }  // namespace edgeslam

@@ -101,17 +101,26 @@ struct MapSlice {
   // The newest keyframe the edge had received when it built the slice: the observations a record
   // lacks in keyframes up to this one were dropped on the edge; newer ones it has not seen yet.
   KeyFrameId newest_keyframe = kInvalidId;
-  bool full_resync = false;               // the client must drop its map and take this one
-  std::vector<KeyFrameRecord> keyframes;  // keyframes the client does not have (resync, edge-made)
+  bool full_resync = false;  // the client must drop its map and take this one
+  // Keyframes the client does not hold: resync, edge-made, or back in the client's bounded window
+  // (the points they see that the client lacks come in points_upserted).
+  std::vector<KeyFrameRecord> keyframes;
   std::vector<MapPointRecord> points_upserted;
   std::vector<PointPositionRecord> point_positions;
   std::vector<MapPointId> points_erased;
   std::vector<KeyFramePoseRecord> keyframe_poses;
   std::vector<KeyFrameId> keyframes_erased;
+  // Bounded client map: held keyframes that left the window around the client's latest keyframe.
+  // The client drops their features and observations (and points no held keyframe sees) but keeps
+  // their poses, which later slices still correct.
+  std::vector<KeyFrameId> keyframes_evicted;
   KeyFrameId reference_keyframe = kInvalidId;
   std::optional<SE3d> reference_pose;  // T_cw of the reference keyframe after optimisation
   std::vector<MaskRecord> masks;
   std::uint32_t loops_closed = 0;  // loops closed on the edge since the last slice
+  // Size of the edge's global map when the slice was built (0 = not said: an older edge).
+  std::uint64_t map_keyframes = 0;
+  std::uint64_t map_points = 0;
 };
 
 }  // namespace edgeslam

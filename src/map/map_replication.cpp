@@ -88,13 +88,19 @@ KeyFramePoseRecord keyFramePoseRecord(const KeyFrame& keyframe) {
 
 KeyFrame* insertKeyFrameRecord(Map& map, const KeyFrameRecord& record,
                                const PinholeCamera& camera) {
-  if (KeyFrame* existing = map.keyFrame(record.id)) return existing;
+  KeyFrame* keyframe = map.keyFrame(record.id);
+  if (keyframe != nullptr && !keyframe->isEvicted()) return keyframe;
   auto features = featuresFromRecord(record.features, camera);
   if (!record.point_ids.empty() && record.point_ids.size() != features->size()) {
     throw std::invalid_argument("keyframe record: point ids must be one per keypoint");
   }
-  KeyFrame* keyframe = map.createKeyFrame(record.frame_index, record.timestamp, std::move(features),
-                                          record.T_cw, record.id);
+  if (keyframe != nullptr) {  // back in the part of the map the replica holds
+    map.restoreKeyFrame(keyframe, std::move(features));
+    map.setKeyFramePose(keyframe, record.T_cw);
+  } else {
+    keyframe = map.createKeyFrame(record.frame_index, record.timestamp, std::move(features),
+                                  record.T_cw, record.id);
+  }
   for (std::size_t i = 0; i < record.point_ids.size(); ++i) {
     if (record.point_ids[i] == kInvalidId) continue;
     MapPoint* p = map.mapPoint(record.point_ids[i]);
@@ -108,6 +114,7 @@ MapPoint* upsertPointRecord(Map& map, const MapPointRecord& record,
   std::vector<std::pair<KeyFrame*, std::size_t>> observers;
   for (const PointObservationRecord& obs : record.observations) {
     KeyFrame* kf = map.keyFrame(obs.keyframe);
+    // size() is 0 for an evicted keyframe: observations there are not held.
     if (kf != nullptr && obs.keypoint_index < kf->size())
       observers.emplace_back(kf, obs.keypoint_index);
   }
@@ -116,6 +123,7 @@ MapPoint* upsertPointRecord(Map& map, const MapPointRecord& record,
   if (point == nullptr) {
     if (observers.empty()) return nullptr;
     KeyFrame* reference = map.keyFrame(record.reference_keyframe);
+    if (reference != nullptr && reference->isEvicted()) reference = nullptr;
     point = map.createMapPoint(record.position,
                                reference != nullptr ? reference : observers[0].first, record.id);
   } else {
@@ -133,6 +141,9 @@ MapPoint* upsertPointRecord(Map& map, const MapPointRecord& record,
     }
   }
   // New observations first: dropping first could leave too few and erase the point.
+  // (eraseObservation culls a point left with two observations or fewer even where the sender
+  // keeps it: detaching instead, to mirror the sender exactly, kept weak points that made KITTI
+  // edge tracking get lost in 5 runs out of 6.)
   for (const auto& [kf, index] : observers) map.addObservation(point, kf, index);
   for (KeyFrame* kf : dropped) {
     if (point->isBad()) break;

@@ -18,14 +18,16 @@ KeyFrameRecord keyFrameRecord(const KeyFrame& keyframe);
 MapPointRecord mapPointRecord(const MapPoint& point);
 KeyFramePoseRecord keyFramePoseRecord(const KeyFrame& keyframe);
 
-// Creates the keyframe with the record's id (or returns the existing one) and links the keypoints
-// whose point ids the map already has. Points named but unknown are left for the caller.
+// Creates the keyframe with the record's id (or returns the existing one; an evicted one gets the
+// record's features and pose back) and links the keypoints whose point ids the map already has.
+// Points named but unknown are left for the caller.
 KeyFrame* insertKeyFrameRecord(Map& map, const KeyFrameRecord& record, const PinholeCamera& camera);
 
 // Creates or updates a point so that its position, appearance and its observations among the
 // keyframes this map has match the record. Observations in keyframes newer than
-// `newest_known_to_sender` (same id origin) are kept: the sender could not know them. Returns
-// nullptr when none of the observing keyframes is here (nothing to attach it to).
+// `newest_known_to_sender` (same id origin) are kept: the sender could not know them. Observations
+// in evicted keyframes are not held. Returns nullptr when none of the observing keyframes is here
+// (nothing to attach it to).
 MapPoint* upsertPointRecord(Map& map, const MapPointRecord& record,
                             KeyFrameId newest_known_to_sender);
 

@@ -465,6 +465,10 @@ MapSlice fromProto(const v1::MapSlice& in) {
                  "masks");
     for (const v1::Mask& m : in.masks()) out.masks.push_back(fromProto(m));
     out.loops_closed = in.loops_closed();
+    out.keyframes_evicted = decodeIdDeltas(in.keyframes_evicted(), wire_limits::kMaxErasedPerSlice,
+                                           "keyframes_evicted");
+    out.map_keyframes = in.map_keyframes();
+    out.map_points = in.map_points();
     return out;
   });
 }
@@ -523,8 +527,12 @@ SessionConfig fromProto(const v1::OpenSessionRequest& in) {
     if (!std::isfinite(s.scale_factor()) || s.scale_factor() <= 1.0 || s.scale_factor() > 4.0) {
       throw WireError(fmt::format("settings.scale_factor {} outside (1, 4]", s.scale_factor()));
     }
+    if (s.client_map_keyframes() > wire_limits::kMaxClientMapKeyFrames) {
+      throw WireError(fmt::format("settings.client_map_keyframes {} exceeds {}",
+                                  s.client_map_keyframes(), wire_limits::kMaxClientMapKeyFrames));
+    }
     out.settings = {static_cast<int>(s.features()), static_cast<int>(s.pyramid_levels()),
-                    s.scale_factor(), s.semantic()};
+                    s.scale_factor(), s.semantic(), static_cast<int>(s.client_map_keyframes())};
     if (in.preferred_id_origin() > 255) {
       throw WireError(fmt::format("preferred_id_origin {} exceeds 255", in.preferred_id_origin()));
     }

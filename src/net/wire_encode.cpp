@@ -362,6 +362,13 @@ void toProto(const MapSlice& slice, v1::MapSlice* out, const WireEncodeOptions& 
   if (slice.reference_pose) toProto(*slice.reference_pose, out->mutable_reference_pose());
   for (const MaskRecord& mask : slice.masks) toProto(mask, out->add_masks());
   out->set_loops_closed(slice.loops_closed);
+  previous = 0;
+  for (const KeyFrameId id : slice.keyframes_evicted) {
+    out->add_keyframes_evicted(idDelta(id, previous));
+    previous = id;
+  }
+  out->set_map_keyframes(slice.map_keyframes);
+  out->set_map_points(slice.map_points);
 }
 
 void toProto(const SessionConfig& config, v1::OpenSessionRequest* out) {
@@ -399,6 +406,8 @@ void toProto(const SessionConfig& config, v1::OpenSessionRequest* out) {
       static_cast<std::uint32_t>(std::max(config.settings.pyramid_levels, 0)));
   settings->set_scale_factor(config.settings.scale_factor);
   settings->set_semantic(config.settings.semantic);
+  settings->set_client_map_keyframes(
+      static_cast<std::uint32_t>(std::max(config.settings.client_map_keyframes, 0)));
   out->set_preferred_id_origin(config.id_origin);
 }
 

@@ -20,6 +20,8 @@ struct SessionSettings {
   int pyramid_levels = 8;
   double scale_factor = 1.2;
   bool semantic = true;
+  // Keyframes the client holds with features and points, around its latest one; 0 = unbounded.
+  int client_map_keyframes = 0;
 };
 
 // What a client opens a session with; id_origin and session_id are filled in by the server.

@@ -32,7 +32,57 @@ void EdgeSlam::beforeTracking(std::size_t frame_index, const cv::Mat& image) {
   if (semantic_filter_) sink_->attachImage(frame_index, image);
 }
 
+void EdgeSlam::noteClientMapSize(std::size_t keyframes, std::size_t points) {
+  std::lock_guard lock(stats_mutex_);
+  client_map_.keyframes = keyframes;
+  client_map_.points = points;
+  client_map_.max_keyframes = std::max(client_map_.max_keyframes, keyframes);
+  client_map_.max_points = std::max(client_map_.max_points, points);
+}
+
+ClientMapSize EdgeSlam::clientMapSize() const {
+  std::size_t keyframes = 0, points = 0;
+  {
+    std::lock_guard lock(map_.updateMutex());
+    keyframes = map_.heldKeyFrameCount();
+    points = map_.pointCount();
+  }
+  std::lock_guard lock(stats_mutex_);
+  ClientMapSize out = client_map_;
+  out.keyframes = keyframes;
+  out.points = points;
+  out.max_keyframes = std::max(out.max_keyframes, keyframes);
+  out.max_points = std::max(out.max_points, points);
+  return out;
+}
+
+std::size_t EdgeSlam::keyFrameCount() const {
+  {
+    std::lock_guard lock(stats_mutex_);
+    if (edge_map_keyframes_ > 0) return edge_map_keyframes_;
+  }
+  return TrackingSlam::keyFrameCount();
+}
+
+std::size_t EdgeSlam::mapPointCount() const {
+  {
+    std::lock_guard lock(stats_mutex_);
+    if (edge_map_points_ > 0) return edge_map_points_;
+  }
+  return TrackingSlam::mapPointCount();
+}
+
 void EdgeSlam::afterFrame() {
+  {
+    // Tracking adds keyframes and points between slices: the client map's peak is seen here.
+    std::size_t keyframes = 0, points = 0;
+    {
+      std::lock_guard lock(map_.updateMutex());
+      keyframes = map_.heldKeyFrameCount();
+      points = map_.pointCount();
+    }
+    noteClientMapSize(keyframes, points);
+  }
   if (!adaptation_) return;
   adaptation_->onFrame();  // counted under the configuration this frame ran with
   const std::uint64_t version = adaptation_->version();
@@ -69,16 +119,28 @@ void EdgeSlam::applyConfiguration(const KeyframeConfig& config) {
 void EdgeSlam::onSlice(MapSlice slice) {
   Stopwatch apply_timer;
   const SliceApplyResult applied = applySlice(map_, slice, camera_);
+  if (tracker_ && (!applied.keyframes_evicted.empty() || !applied.keyframes_entered.empty())) {
+    tracker_->onMapWindowChanged(applied.keyframes_evicted, applied.keyframes_entered);
+  }
   const double apply_ms = apply_timer.elapsedMs();
+  noteClientMapSize(applied.keyframes_held, applied.points_held);
   spdlog::debug(
-      "slice {} (keyframe of frame {}): {} points written, {} erased, {} poses, {:.1f} ms",
+      "slice {} (keyframe of frame {}): {} points written, {} erased, {} poses, {} keyframes "
+      "evicted ({} points), {} back, {:.1f} ms",
       slice.sequence, applied.frame_index, applied.points_upserted, applied.points_erased,
-      applied.keyframes_moved, apply_ms);
+      applied.keyframes_moved, applied.keyframes_evicted.size(), applied.points_evicted,
+      applied.keyframes_entered.size(), apply_ms);
   const double latency_s = sink_->onSliceApplied(slice.upload_sequence, applied.frame_index);
   for (const MaskRecord& mask : slice.masks) offerMask(mask);
   std::lock_guard lock(stats_mutex_);
   ++slices_applied_;
   loops_ += slice.loops_closed;
+  if (slice.map_keyframes > 0 || slice.map_points > 0) {
+    edge_map_keyframes_ = slice.map_keyframes;
+    edge_map_points_ = slice.map_points;
+  }
+  client_map_.keyframes_evicted += applied.keyframes_evicted.size();
+  client_map_.keyframes_entered += applied.keyframes_entered.size();
   slice_apply_ms_.add(apply_ms);
   if (latency_s >= 0.0) slice_latency_ms_.add(latency_s * 1000.0);
 }

@@ -13,6 +13,16 @@
 
 namespace edgeslam {
 
+// The client's own map (bounded or not): what it holds now and the most it held.
+struct ClientMapSize {
+  std::size_t keyframes = 0;  // held: with features and points (not evicted)
+  std::size_t points = 0;
+  std::size_t max_keyframes = 0;
+  std::size_t max_points = 0;
+  std::size_t keyframes_evicted = 0;  // evictions applied over the run
+  std::size_t keyframes_entered = 0;  // keyframes sent back into the window
+};
+
 class EdgeSlam : public TrackingSlam {
  public:
   // With `adaptation` and a networked link, a probing loop retunes the keyframe rules and the
@@ -27,6 +37,11 @@ class EdgeSlam : public TrackingSlam {
   // nullptr without adaptation.
   const AdaptationLoop* adaptation() const { return adaptation_.get(); }
   const char* modeName() const override { return "edge"; }
+  // The global map on the edge as the last slice reported it (the client's own map until then;
+  // with a bounded client map the client holds only a part of it).
+  std::size_t keyFrameCount() const override;
+  std::size_t mapPointCount() const override;
+  ClientMapSize clientMapSize() const;
 
   double finish_timeout_s = 30.0;
 
@@ -36,6 +51,7 @@ class EdgeSlam : public TrackingSlam {
   void afterFrame() override;
   void beforeTracking(std::size_t frame_index, const cv::Mat& image) override;
   void applyConfiguration(const KeyframeConfig& config);
+  void noteClientMapSize(std::size_t keyframes, std::size_t points);
 
   std::unique_ptr<EdgeLink> link_;
   std::unique_ptr<EdgeKeyFrameSink> sink_;
@@ -49,6 +65,9 @@ class EdgeSlam : public TrackingSlam {
   std::uint64_t loops_ = 0;
   std::uint64_t keyframes_segmented_ = 0;
   SampleStats segmentation_ms_;
+  std::uint64_t edge_map_keyframes_ = 0;  // as the last slice said (0 = not said)
+  std::uint64_t edge_map_points_ = 0;
+  ClientMapSize client_map_;
 };
 
 }  // namespace edgeslam

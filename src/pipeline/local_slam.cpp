@@ -8,6 +8,8 @@ namespace edgeslam {
 
 LocalSlam::LocalSlam(const PinholeCamera& camera, SlamOptions options)
     : TrackingSlam(camera, std::move(options), 0) {
+  // The session's vocabulary serves the mapper's bag-of-words triangulation search too.
+  if (!options_.mapper.vocabulary) options_.mapper.vocabulary = options_.vocabulary;
   mapper_ = std::make_unique<LocalMapper>(map_, camera_, options_.mapper);
   if (options_.vocabulary != nullptr && options_.loop_closing) {
     LoopCloserOptions loop = options_.loop_closer;

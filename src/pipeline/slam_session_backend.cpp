@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 
@@ -54,6 +55,9 @@ void SlamSessionBackend::onKeyFrame(KeyFrameUpload upload) {
     EdgeMapSessionOptions mapping = options_.mapping;
     mapping.mapper.observe_recent_points = true;
     mapping.segmenter = segmenter_;
+    // The client bounds its map: the window follows its setting.
+    mapping.window.keyframes =
+        static_cast<std::size_t>(std::max(0, config_.settings.client_map_keyframes));
     mapping_ = std::make_unique<EdgeMapSession>(
         config_.camera, config_.sensor, mapping, [this](MapSlice slice) {
           try {

@@ -108,6 +108,9 @@ inline MapSlice sampleSlice(std::uint64_t sequence, std::mt19937& rng) {
   s.reference_pose = samplePose(rng);
   s.masks.push_back({clientId(3, 8), 160, 120, "png/4", {0x89, 'P', 'N', 'G', 9}, 131.5});
   s.loops_closed = 2;
+  s.keyframes_evicted = {clientId(3, 5), clientId(3, 6), clientId(0, 1)};
+  s.map_keyframes = 321;
+  s.map_points = 45678;
   return s;
 }
 
@@ -126,7 +129,7 @@ inline SessionConfig sampleSessionConfig(const std::string& name = "test-client"
   config.client_name = name;
   config.camera = PinholeCamera(in);
   config.sensor = Sensor::kRgbd;
-  config.settings = {1500, 6, 1.25, false};
+  config.settings = {1500, 6, 1.25, false, 35};
   return config;
 }
 

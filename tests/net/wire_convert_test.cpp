@@ -322,6 +322,9 @@ TEST(WireConvert, SliceRoundTrip) {
     EXPECT_EQ(back.masks[0].bytes, s.masks[0].bytes);
     EXPECT_FLOAT_EQ(static_cast<float>(back.masks[0].segmentation_ms), 131.5f);
     EXPECT_EQ(back.loops_closed, s.loops_closed);
+    EXPECT_EQ(back.keyframes_evicted, s.keyframes_evicted);
+    EXPECT_EQ(back.map_keyframes, 321u);
+    EXPECT_EQ(back.map_points, 45678u);
   }
   MapSlice empty;
   empty.sequence = 3;
@@ -333,6 +336,9 @@ TEST(WireConvert, SliceRoundTrip) {
   EXPECT_TRUE(empty_back.points_upserted.empty());
   EXPECT_TRUE(empty_back.point_positions.empty());
   EXPECT_TRUE(empty_back.keyframe_poses.empty());
+  // A slice from an edge that does not bound the client's map (or an older one) evicts nothing.
+  EXPECT_TRUE(empty_back.keyframes_evicted.empty());
+  EXPECT_EQ(empty_back.map_points, 0u);
 }
 
 TEST(WireConvert, SessionConfigRoundTrip) {
@@ -362,7 +368,11 @@ TEST(WireConvert, SessionConfigRoundTrip) {
   EXPECT_EQ(back.settings.pyramid_levels, 6);
   EXPECT_EQ(back.settings.scale_factor, 1.25);
   EXPECT_FALSE(back.settings.semantic);
+  EXPECT_EQ(back.settings.client_map_keyframes, 35);
   EXPECT_EQ(back.id_origin, 42);
+  // An older client does not send the field: unbounded.
+  message.mutable_settings()->clear_client_map_keyframes();
+  EXPECT_EQ(fromProto(message).settings.client_map_keyframes, 0);
 }
 
 TEST(WireConvert, OffloadRoundTrip) {

@@ -243,6 +243,9 @@ TEST(WireValidation, UploadAndSliceEnvelopes) {
   // Back from the last erased id to 0.
   zero_erased.add_points_erased(-static_cast<std::int64_t>(test::clientId(0, 5)));
   EXPECT_THAT(decodeError(zero_erased), HasSubstr("points_erased[2] is 0"));
+  v1::MapSlice zero_evicted = slice;
+  zero_evicted.add_keyframes_evicted(-static_cast<std::int64_t>(test::clientId(0, 1)));
+  EXPECT_THAT(decodeError(zero_evicted), HasSubstr("keyframes_evicted[3] is 0"));
   v1::MapSlice flat_pose = slice;
   flat_pose.mutable_keyframe_poses()->mutable_poses()->replace(0, 16, std::string(16, '\0'));
   EXPECT_THAT(decodeError(flat_pose),
@@ -274,6 +277,9 @@ TEST(WireValidation, SessionAndOffloadRequests) {
   v1::OpenSessionRequest bad_levels = request;
   bad_levels.mutable_settings()->set_pyramid_levels(0);
   EXPECT_THAT(decodeError(bad_levels), HasSubstr("settings.pyramid_levels 0"));
+  v1::OpenSessionRequest huge_window = request;
+  huge_window.mutable_settings()->set_client_map_keyframes(4000000000u);
+  EXPECT_THAT(decodeError(huge_window), HasSubstr("settings.client_map_keyframes 4000000000"));
 
   v1::OffloadFrameRequest frame;
   frame.set_image_encoding("bmp");

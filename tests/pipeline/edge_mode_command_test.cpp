@@ -46,6 +46,23 @@ TEST(EdgeModeCommand, RgbdEdgeModeSendsKeyframesAndAppliesEverySlice) {
   EXPECT_LT(m["ate_final"]["rmse_m"].get<double>(), 0.05);
 }
 
+TEST(EdgeModeCommand, BoundedClientMapHoldsAPartOfTheEdgeMap) {
+  EDGESLAM_REQUIRE_SHARED(kSequence);
+  const auto m = runMode("edge", "--sensor rgbd --client-map-keyframes 3", 150);
+  ASSERT_FALSE(m.empty());
+  EXPECT_GE(m["tracked"].get<int>(), 145);
+  const auto& c = m["client_map"];
+  ASSERT_TRUE(c.is_object()) << m.dump();
+  EXPECT_EQ(c["window_keyframes"], 3);
+  EXPECT_GT(c["keyframes_evicted"].get<int>(), 0);
+  // Keep window ceil(1.5 * 3) = 5, plus keyframes made since the last slice.
+  EXPECT_LE(c["keyframes"].get<int>(), 7);
+  EXPECT_LT(c["keyframes"].get<int>(), m["keyframes"].get<int>());
+  EXPECT_LT(c["points"].get<int>(), m["map_points"].get<int>());
+  EXPECT_GE(c["max_points"].get<int>(), c["points"].get<int>());
+  EXPECT_LT(m["ate_final"]["rmse_m"].get<double>(), 0.05);
+}
+
 TEST(EdgeModeCommand, OffloadModeTracksOnTheEdge) {
   EDGESLAM_REQUIRE_SHARED(kSequence);
   const auto m = runMode("offload", "--sensor rgbd", 40);

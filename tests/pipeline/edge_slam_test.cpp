@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include <set>
+
 #include "eval/ate.h"
 #include "io/dataset.h"
 #include "pipeline/in_process_edge_link.h"
@@ -31,6 +33,10 @@ TEST(EdgeSlam, ClientMapReplicatesTheEdgeMapOnKitti) {
   Map& edge = raw_link->session().map();
   std::lock_guard edge_lock(edge.updateMutex());
   EXPECT_GT(edge.pointCount(), 300u);
+  EXPECT_EQ(slam.map().keyFrameCount(), edge.keyFrameCount());
+  EXPECT_EQ(slam.map().heldKeyFrameCount(), edge.keyFrameCount());
+  EXPECT_EQ(slam.map().pointCount(), edge.pointCount());
+  // What the edge reported in its last slice.
   EXPECT_EQ(slam.keyFrameCount(), edge.keyFrameCount());
   EXPECT_EQ(slam.mapPointCount(), edge.pointCount());
   for (MapPoint* p : edge.mapPoints()) {
@@ -49,6 +55,69 @@ TEST(EdgeSlam, ClientMapReplicatesTheEdgeMapOnKitti) {
     }
   }
   EXPECT_EQ(compared, edge.keyFrameCount());
+}
+
+// With a bounded client map the client holds exactly the keyframes the edge's window says, every
+// point a held keyframe sees (as the edge has it, observations among held keyframes), nothing
+// else, and every keyframe's pose, evicted or not.
+TEST(EdgeSlam, BoundedClientMapHoldsTheEdgeWindowOnKitti) {
+  EDGESLAM_REQUIRE_SHARED("datasets/kitti07-160");
+  auto reader = openDataset(test::sharedPath("datasets/kitti07-160"));
+  const PinholeCamera& camera = reader->camera();
+  SlamOptions options = defaultSlamOptions(camera, Sensor::kMonocular);
+  EdgeMapSessionOptions edge_options;
+  edge_options.threaded = false;
+  edge_options.window.keyframes = 6;
+  auto link = std::make_unique<InProcessEdgeLink>(camera, Sensor::kMonocular, edge_options);
+  InProcessEdgeLink* raw_link = link.get();
+  EdgeSlam slam(camera, options, std::move(link));
+  std::size_t tracked = 0;
+  for (std::size_t i = 0; i < 40; ++i) {
+    const DatasetFrame frame = reader->load(i);
+    if (slam.process(i, frame.timestamp, frame.gray, frame.depth).state == TrackingState::kOk) {
+      ++tracked;
+    }
+    raw_link->flush();
+  }
+  slam.finish();
+  EXPECT_GE(tracked, 35u);
+  const ClientMapSize size = slam.clientMapSize();
+  EdgeMapSession& session = raw_link->session();
+  Map& edge = session.map();
+  std::lock_guard edge_lock(edge.updateMutex());
+  std::lock_guard client_lock(slam.map().updateMutex());
+  const Map& client = slam.map();
+  const std::set<KeyFrameId>& held = session.clientWindow().held();
+  ASSERT_GT(edge.keyFrameCount(), held.size()) << "the run must leave the window";
+  EXPECT_LE(held.size(), session.clientWindow().keepSize());
+  EXPECT_GT(session.stats().client_keyframes_evicted, 0u);
+  EXPECT_EQ(client.keyFrameCount(), edge.keyFrameCount());
+  EXPECT_EQ(client.heldKeyFrameCount(), held.size());
+  for (KeyFrame* kf : edge.keyFrames()) {
+    const KeyFrame* replica = client.keyFrame(kf->id());
+    ASSERT_NE(replica, nullptr) << "keyframe " << kf->id() << " missing on the client";
+    EXPECT_EQ(replica->isEvicted(), !held.contains(kf->id()));
+    EXPECT_LT((replica->cameraCenter() - kf->cameraCenter()).norm(), 1e-9);
+  }
+  std::size_t seen_by_held = 0;
+  for (MapPoint* p : edge.mapPoints()) {
+    std::size_t held_observations = 0;
+    for (const auto& [id, obs] : p->observations()) held_observations += held.contains(id);
+    const MapPoint* replica = client.mapPoint(p->id());
+    if (held_observations == 0) {
+      EXPECT_EQ(replica, nullptr) << "point " << p->id() << " seen by no held keyframe";
+      continue;
+    }
+    ++seen_by_held;
+    ASSERT_NE(replica, nullptr) << "point " << p->id() << " seen by a held keyframe is missing";
+    EXPECT_LT((replica->position() - p->position()).norm(), 1e-9);
+    EXPECT_EQ(replica->observations().size(), held_observations);
+  }
+  EXPECT_EQ(client.pointCount(), seen_by_held);
+  EXPECT_LT(client.pointCount(), edge.pointCount());
+  EXPECT_EQ(size.points, client.pointCount());
+  EXPECT_EQ(size.keyframes, held.size());
+  EXPECT_GE(size.max_points, size.points);
 }
 
 }  // namespace
