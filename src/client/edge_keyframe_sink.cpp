@@ -17,7 +17,10 @@ void EdgeKeyFrameSink::insertKeyFrame(KeyFrame* keyframe) {
     const std::uint8_t own_origin = idOrigin(keyframe->id());
     for (MapPoint* p : keyframe->goodPoints()) {
       if (idOrigin(p->id()) != own_origin || uploaded_points_.contains(p->id())) continue;
-      upload.new_points.push_back(mapPointRecord(*p));
+      MapPointRecord record = mapPointRecord(*p);
+      record.position_from_depth =
+          options_.camera.has_value() && isDepthBackProjection(*p, *keyframe, *options_.camera);
+      upload.new_points.push_back(std::move(record));
       uploaded_points_.insert(p->id());
     }
     upload.segmenter_nms = segmenter_nms_.load();

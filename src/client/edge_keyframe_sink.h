@@ -6,9 +6,11 @@
 #include <cstdint>
 #include <deque>
 #include <mutex>
+#include <optional>
 #include <unordered_set>
 
 #include "client/keyframe_uplink.h"
+#include "geometry/camera.h"
 #include "map/keyframe_sink.h"
 #include "map/map.h"
 
@@ -17,6 +19,9 @@ namespace edgeslam {
 struct EdgeKeyFrameSinkOptions {
   // Tracking holds back optional keyframes while this many uploads wait for their slice.
   std::size_t max_in_flight = 3;
+  // With the camera, new points that are the depth back-projection of their keypoint in the
+  // uploaded keyframe are flagged so that the wire leaves their positions out (~12 bytes each).
+  std::optional<PinholeCamera> camera;
 };
 
 class EdgeKeyFrameSink : public KeyFrameSink {

@@ -77,8 +77,10 @@ void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
     // The client already has what it sent: apply it without recording it for the slices.
     map_.setChangeRecording(false);
     try {
+      std::vector<MapPointRecord> new_points = upload.new_points;
+      rebuildPositionsFromDepth(new_points, upload.keyframe, camera_);
       keyframe = insertKeyFrameRecord(map_, upload.keyframe, camera_);
-      for (const MapPointRecord& point : upload.new_points) {
+      for (const MapPointRecord& point : new_points) {
         if (map_.mapPoint(point.id) != nullptr) continue;
         // Normal, descriptor and distance range follow from the observations: the upload need
         // not carry them.

@@ -30,6 +30,10 @@ struct MapPointRecord {
   float max_distance = 0.f;
   KeyFrameId reference_keyframe = kInvalidId;
   std::vector<PointObservationRecord> observations;
+  // Uploads only: the position is the back-projection of the first observation, a keypoint with
+  // depth of the uploaded keyframe, so the wire leaves it out and the receiver rebuilds it
+  // (rebuildPositionsFromDepth in map_replication.h).
+  bool position_from_depth = false;
 };
 
 // A keyframe's features as extracted on the client: enough to rebuild its FrameFeatures on the

@@ -156,4 +156,50 @@ MapPoint* upsertPointRecord(Map& map, const MapPointRecord& record,
   return point;
 }
 
+namespace {
+
+Eigen::Vector3d backProject(const cv::KeyPoint& keypoint, float depth, const SE3d& T_wc,
+                            const PinholeCamera& camera) {
+  return T_wc * (camera.unproject({keypoint.pt.x, keypoint.pt.y}) * static_cast<double>(depth));
+}
+
+}  // namespace
+
+bool isDepthBackProjection(const MapPoint& point, const KeyFrame& keyframe,
+                           const PinholeCamera& camera) {
+  constexpr double kTolerance = 1e-4;  // m; the wire's keypoints and depths are finer than this
+  const auto& observations = point.observations();
+  if (observations.empty()) return false;
+  const auto& first = observations.begin()->second;
+  if (first.keyframe != &keyframe) return false;
+  const FrameFeatures& features = keyframe.features();
+  if (first.index >= features.size() || !features.hasDepth(first.index)) return false;
+  const Eigen::Vector3d expected = backProject(
+      features.keypoints[first.index], features.depth[first.index], keyframe.poseInverse(), camera);
+  return (expected - point.position()).norm() <= kTolerance;
+}
+
+void rebuildPositionsFromDepth(std::vector<MapPointRecord>& points, const KeyFrameRecord& keyframe,
+                               const PinholeCamera& camera) {
+  const KeyFrameFeaturesRecord& features = keyframe.features;
+  const SE3d T_wc = keyframe.T_cw.inverse();
+  for (MapPointRecord& point : points) {
+    if (!point.position_from_depth) continue;
+    const auto fail = [&](const std::string& why) {
+      throw std::invalid_argument("point " + std::to_string(point.id) +
+                                  ": position from depth, but " + why);
+    };
+    if (point.observations.empty()) fail("it has no observation");
+    const PointObservationRecord& first = point.observations.front();
+    if (first.keyframe != keyframe.id) fail("its first observation is in another keyframe");
+    if (first.keypoint_index >= features.keypoints.size()) fail("its keypoint does not exist");
+    if (first.keypoint_index >= features.depth.size() ||
+        !(features.depth[first.keypoint_index] > 0.f)) {
+      fail("its keypoint has no depth");
+    }
+    point.position = backProject(features.keypoints[first.keypoint_index],
+                                 features.depth[first.keypoint_index], T_wc, camera);
+  }
+}
+
 }  // namespace edgeslam

@@ -31,4 +31,14 @@ KeyFrame* insertKeyFrameRecord(Map& map, const KeyFrameRecord& record, const Pin
 MapPoint* upsertPointRecord(Map& map, const MapPointRecord& record,
                             KeyFrameId newest_known_to_sender);
 
+// Uploads of RGB-D keyframes. The sender flags a new point whose position is the back-projection
+// of its first observation in `keyframe` (within 0.1 mm), so that the wire can leave it out...
+bool isDepthBackProjection(const MapPoint& point, const KeyFrame& keyframe,
+                           const PinholeCamera& camera);
+// ...and the receiver rebuilds the flagged positions from the keyframe as it arrived. Throws
+// std::invalid_argument when a flagged point's first observation is not a keypoint with depth of
+// `keyframe`.
+void rebuildPositionsFromDepth(std::vector<MapPointRecord>& points, const KeyFrameRecord& keyframe,
+                               const PinholeCamera& camera);
+
 }  // namespace edgeslam

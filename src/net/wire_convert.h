@@ -23,6 +23,9 @@ struct WireEncodeOptions {
   // The edge recomputes normal, descriptor and distance range of uploaded points from their
   // observations: uploads leave them out (44 bytes a point) unless asked.
   bool upload_point_appearance = false;
+  // Bytes per keypoint angle: 1 (1.4-degree steps; ORB matching compares orientations in
+  // 12-degree bins) or 2.
+  int angle_bytes = 1;
 };
 
 void toProto(const SE3d& pose, v1::Pose* out);

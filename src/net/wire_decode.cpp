@@ -74,7 +74,12 @@ std::vector<cv::KeyPoint> decodeKeyPoints(const v1::KeyPoints& in, const ScaleLe
   }
   const Column x(in.x(), n, static_cast<int>(width), "keypoints.x");
   const Column y(in.y(), n, static_cast<int>(width), "keypoints.y");
-  const Column angle(in.angle(), n, 2, "keypoints.angle");
+  const std::uint32_t angle_bytes = in.angle_bytes() == 0 ? 2 : in.angle_bytes();
+  if (angle_bytes != 1 && angle_bytes != 2) {
+    throw WireError(fmt::format("keypoints.angle_bytes {} is neither 1 nor 2", in.angle_bytes()));
+  }
+  const Column angle(in.angle(), n, static_cast<int>(angle_bytes), "keypoints.angle");
+  const double angle_steps_per_degree = angleStepsPerDegree(static_cast<int>(angle_bytes));
   const bool octave_runs = in.octave_runs_size() > 0;
   if (octave_runs && !in.octave().empty()) {
     throw WireError("keypoints carry both octave and octave_runs");
@@ -110,7 +115,8 @@ std::vector<cv::KeyPoint> decodeKeyPoints(const v1::KeyPoints& in, const ScaleLe
     kp.pt.y = static_cast<float>(
         static_cast<double>(in.y_origin() + static_cast<std::int64_t>(y.unsignedAt(i))) /
         kCoordinateSteps);
-    kp.angle = static_cast<float>(static_cast<double>(angle.unsignedAt(i)) / kAngleStepsPerDegree);
+    kp.angle =
+        static_cast<float>(static_cast<double>(angle.unsignedAt(i)) / angle_steps_per_degree);
     const std::uint64_t level = octave_runs ? run_octaves[i] : octave.unsignedAt(i);
     if (level >= static_cast<std::uint64_t>(scales.numLevels())) {
       throw WireError(fmt::format("keypoint {} has octave {} but the pyramid has {} levels", i,
@@ -271,7 +277,19 @@ std::vector<MapPointRecord> fromProto(const v1::MapPoints& in) {
   requireN(in.id_deltas(), n, "points.id_deltas", "points");
   requireN(in.reference_deltas(), n, "points.reference_deltas", "points");
   requireN(in.observation_counts(), n, "points.observation_counts", "points");
-  const Column positions(in.positions(), 3 * n, 4, "points.positions");
+  const std::string& from_depth = in.positions_from_depth();
+  if (!from_depth.empty() && from_depth.size() != (n + 7) / 8) {
+    throw WireError(fmt::format("points.positions_from_depth has {} bytes for {} points",
+                                from_depth.size(), n));
+  }
+  const auto positionFromDepth = [&](std::size_t i) {
+    return !from_depth.empty() &&
+           ((static_cast<unsigned char>(from_depth[i / 8]) >> (i % 8)) & 1u) != 0;
+  };
+  std::size_t explicit_positions = 0;
+  for (std::size_t i = 0; i < n; ++i) explicit_positions += positionFromDepth(i) ? 0 : 1;
+  const Column positions(in.positions(), 3 * explicit_positions, 4, "points.positions");
+  std::size_t next_position = 0;
   const bool with_appearance =
       !in.normals().empty() || !in.descriptors().empty() || !in.distances().empty();
   const Column normals(in.normals(), with_appearance ? 3 * n : 0, 2, "points.normals");
@@ -301,7 +319,14 @@ std::vector<MapPointRecord> fromProto(const v1::MapPoints& in) {
       MapPointRecord& point = out[i];
       requireId(id, "id");
       point.id = id;
-      point.position = positionAt(positions, i);
+      if (positionFromDepth(i)) {
+        if (in.observation_counts(k) == 0) {
+          throw WireError("position from depth but no observation to take it from");
+        }
+        point.position_from_depth = true;  // rebuilt by the receiver from the keyframe
+      } else {
+        point.position = positionAt(positions, next_position++);
+      }
       if (with_appearance) {
         point.normal = Eigen::Vector3d(normals.int16At(3 * i), normals.int16At(3 * i + 1),
                                        normals.int16At(3 * i + 2)) /

@@ -61,7 +61,13 @@ void encodeKeyPoints(const KeyFrameFeaturesRecord& features, KeyFrameId id, v1::
   std::vector<std::int64_t> ys(n);
   std::string* angles = out->mutable_angle();
   std::string* octaves = out->mutable_octave();
-  angles->reserve(2 * n);
+  const int angle_bytes = options.angle_bytes;
+  if (angle_bytes != 1 && angle_bytes != 2) {
+    throw WireError(fmt::format("angle_bytes must be 1 or 2, got {}", angle_bytes));
+  }
+  out->set_angle_bytes(static_cast<std::uint32_t>(angle_bytes));
+  const std::uint64_t angle_mask = angle_bytes == 1 ? 0xffu : 0xffffu;
+  angles->reserve(static_cast<std::size_t>(angle_bytes) * n);
   octaves->reserve(n);
   for (std::size_t i = 0; i < n; ++i) {
     const cv::KeyPoint& kp = keypoints[i];
@@ -71,8 +77,8 @@ void encodeKeyPoints(const KeyFrameFeaturesRecord& features, KeyFrameId id, v1::
       throw WireError(fmt::format("keyframe {:#x}: keypoint {} has angle {}", id, i, kp.angle));
     }
     const double degrees = std::fmod(static_cast<double>(kp.angle), 360.0);  // a direction
-    const long steps = std::lround(degrees * kAngleStepsPerDegree);
-    putUnsigned(*angles, static_cast<std::uint64_t>(steps) & 0xffffu, 2);
+    const long steps = std::lround(degrees * angleStepsPerDegree(angle_bytes));
+    putUnsigned(*angles, static_cast<std::uint64_t>(steps) & angle_mask, angle_bytes);
     if (kp.octave < 0 || kp.octave > 255) {
       throw WireError(fmt::format("keyframe {:#x}: keypoint {} has octave {}", id, i, kp.octave));
     }
@@ -250,12 +256,21 @@ void toProto(const std::vector<MapPointRecord>& points, v1::MapPoints* out, bool
   out->mutable_observation_counts()->Reserve(count);
   std::string* positions = out->mutable_positions();
   positions->reserve(12 * n);
+  const bool any_from_depth = std::any_of(points.begin(), points.end(), [](const auto& point) {
+    return point.position_from_depth && !point.observations.empty();
+  });
+  if (any_from_depth) out->mutable_positions_from_depth()->assign((n + 7) / 8, '\0');
   std::uint64_t previous_id = 0;
   std::uint64_t previous_first_keyframe = points.front().id;
-  for (const MapPointRecord& point : points) {
+  for (std::size_t i = 0; i < n; ++i) {
+    const MapPointRecord& point = points[i];
     out->add_id_deltas(idDelta(point.id, previous_id));
     previous_id = point.id;
-    putPosition(*positions, point.position, point.id);
+    if (any_from_depth && point.position_from_depth && !point.observations.empty()) {
+      (*out->mutable_positions_from_depth())[i / 8] |= static_cast<char>(1u << (i % 8));
+    } else {
+      putPosition(*positions, point.position, point.id);
+    }
     out->add_observation_counts(static_cast<std::uint32_t>(point.observations.size()));
     std::uint64_t previous_keyframe = previous_first_keyframe;
     for (const PointObservationRecord& obs : point.observations) {

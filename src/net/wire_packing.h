@@ -18,8 +18,10 @@ namespace edgeslam::wire_packing {
 constexpr int kCoordinateSteps = 32;
 // Larger coordinates than this (in px) are not a keypoint of any camera: refused when encoding.
 constexpr double kMaxCoordinate = 1.0e6;
-// Angles in 1/65536 turn (uint16): at most 0.0028 degrees off.
-constexpr double kAngleStepsPerDegree = 65536.0 / 360.0;
+// Angles in 1/256 turn (one byte, at most 0.7 degrees off) or 1/65536 turn (two bytes).
+constexpr double angleStepsPerDegree(int bytes) {
+  return (bytes == 1 ? 256.0 : 65536.0) / 360.0;
+}
 // Depths in millimetres (uint16, 0 = unknown): at most 0.5 mm off, up to 65.535 m.
 constexpr double kDepthStepsPerMetre = 1000.0;
 constexpr std::uint32_t kMaxDepthSteps = 65535;

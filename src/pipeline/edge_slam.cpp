@@ -14,7 +14,9 @@ namespace edgeslam {
 EdgeSlam::EdgeSlam(const PinholeCamera& camera, SlamOptions options, std::unique_ptr<EdgeLink> link,
                    std::optional<AdaptationLoopOptions> adaptation)
     : TrackingSlam(camera, std::move(options), link->idOrigin()), link_(std::move(link)) {
-  sink_ = std::make_unique<EdgeKeyFrameSink>(map_, *link_);
+  EdgeKeyFrameSinkOptions sink_options;
+  sink_options.camera = camera_;
+  sink_ = std::make_unique<EdgeKeyFrameSink>(map_, *link_, sink_options);
   link_->setSliceHandler([this](MapSlice slice) { onSlice(std::move(slice)); });
   startTracking(sink_.get());
   if (adaptation && link_->edgeClient() != nullptr) {

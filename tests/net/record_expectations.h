@@ -13,7 +13,7 @@ namespace edgeslam::test {
 
 // Largest round-trip errors the wire may introduce (plus float rounding of the decoded value).
 constexpr double kCoordinateTolerancePx = 1.0 / 64.0 + 1e-4;
-constexpr double kAngleToleranceDeg = 360.0 / 65536.0 / 2.0 + 1e-4;
+constexpr double kAngleToleranceDeg = 360.0 / 256.0 / 2.0 + 1e-4;  // one byte per angle
 constexpr double kDepthToleranceM = 0.0005 + 1e-6;
 constexpr double kNormalTolerance = 1.0 / 32767.0;
 constexpr double kFloat32Relative = 1e-7;

@@ -62,8 +62,8 @@ TEST(WireConvert, KeyFrameRoundTripWithinQuantisation) {
 }
 
 // Coordinates to 1/32 px (at most 1/64 px off: far below the ~0.5 px noise of an ORB keypoint at
-// level 0, and below the 0.05 px asked), angles to 1/65536 turn; the byte width of coordinates
-// follows the spread of the keypoints.
+// level 0, and below the 0.05 px asked), angles to 1/256 turn (or 1/65536 with two bytes); the
+// byte width of coordinates follows the spread of the keypoints.
 TEST(WireConvert, KeypointQuantisationErrors) {
   std::mt19937 rng(21);
   for (const auto& [width, expected_bytes] : {std::pair{200.f, 1u}, std::pair{1226.f, 2u},
@@ -82,6 +82,19 @@ TEST(WireConvert, KeypointQuantisationErrors) {
     v1::KeyFrame message;
     toProto(kf, &message);
     EXPECT_EQ(message.features().keypoints().coordinate_bytes(), expected_bytes) << width;
+    EXPECT_EQ(message.features().keypoints().angle().size(), kf.features.keypoints.size());
+    WireEncodeOptions two_byte_angles;
+    two_byte_angles.angle_bytes = 2;
+    v1::KeyFrame fine;
+    toProto(kf, &fine, two_byte_angles);
+    const KeyFrameRecord fine_back = fromProto(reparsed(fine));
+    double max_fine_angle_error = 0.0;
+    for (std::size_t i = 0; i < kf.features.keypoints.size(); ++i) {
+      max_fine_angle_error = std::max(
+          max_fine_angle_error, test::angleDifferenceDeg(kf.features.keypoints[i].angle,
+                                                         fine_back.features.keypoints[i].angle));
+    }
+    EXPECT_LE(max_fine_angle_error, 360.0 / 65536.0 / 2.0 + 1e-4) << width;
     const KeyFrameRecord back = fromProto(reparsed(message));
     double max_coordinate_error = 0.0;
     double max_angle_error = 0.0;
@@ -98,7 +111,8 @@ TEST(WireConvert, KeypointQuantisationErrors) {
     EXPECT_LE(max_coordinate_error, 1.0 / 64.0 + 1e-4) << width;
     EXPECT_LT(max_coordinate_error, 0.05) << width;
     EXPECT_GT(max_coordinate_error, 0.0) << "coordinates are quantised";
-    EXPECT_LE(max_angle_error, 360.0 / 65536.0 / 2.0 + 1e-4) << width;
+    EXPECT_LE(max_angle_error, 360.0 / 256.0 / 2.0 + 1e-4) << width;
+    EXPECT_GT(max_angle_error, 360.0 / 65536.0) << "one byte per angle";
     expectKeyFrameNear(kf, back, /*compare_response=*/false);
   }
 }
@@ -276,6 +290,35 @@ TEST(WireConvert, UploadRoundTrip) {
   v1::KeyFrameUpload plain;
   toProto(u, &plain);
   EXPECT_FALSE(fromProto(plain).map_reset);
+}
+
+// Points flagged as depth back-projections travel without their position (12 bytes each); the
+// flag comes back for the edge to rebuild the position from the keyframe.
+TEST(WireConvert, PositionsFromDepthStayHome) {
+  std::mt19937 rng(15);
+  KeyFrameUpload u = test::sampleUpload(9, 100, 20, rng);
+  for (std::size_t i = 0; i < u.new_points.size(); i += 2)
+    u.new_points[i].position_from_depth = true;
+  v1::KeyFrameUpload message;
+  toProto(u, &message);
+  EXPECT_EQ(message.new_points().positions().size(), 10u * 12u);
+  EXPECT_EQ(message.new_points().positions_from_depth().size(), 3u);
+  const KeyFrameUpload back = fromProto(reparsed(message));
+  ASSERT_EQ(back.new_points.size(), u.new_points.size());
+  for (std::size_t i = 0; i < u.new_points.size(); ++i) {
+    EXPECT_EQ(back.new_points[i].position_from_depth, i % 2 == 0) << i;
+    if (i % 2 == 1) {
+      EXPECT_LT((back.new_points[i].position - u.new_points[i].position).norm(), 1e-5) << i;
+    }
+    EXPECT_EQ(back.new_points[i].observations.size(), u.new_points[i].observations.size());
+  }
+
+  v1::KeyFrameUpload short_bitmap = message;
+  short_bitmap.mutable_new_points()->mutable_positions_from_depth()->pop_back();
+  EXPECT_THROW(fromProto(short_bitmap), WireError);
+  v1::KeyFrameUpload unflagged = message;  // the bitmap gone: positions no longer add up
+  unflagged.mutable_new_points()->clear_positions_from_depth();
+  EXPECT_THROW(fromProto(unflagged), WireError);
 }
 
 TEST(WireConvert, SliceRoundTrip) {

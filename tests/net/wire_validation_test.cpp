@@ -50,7 +50,15 @@ TEST(WireValidation, PerKeypointArraysMustBeConsistent) {
 
   v1::KeyFrame short_angle = validKeyFrame();
   short_angle.mutable_features()->mutable_keypoints()->mutable_angle()->append("x");
-  EXPECT_THAT(decodeError(short_angle), HasSubstr("keypoints.angle holds 21 bytes"));
+  EXPECT_THAT(decodeError(short_angle), HasSubstr("keypoints.angle holds 11 bytes"));
+
+  v1::KeyFrame two_byte_angles = validKeyFrame();  // the layout of old senders: 2 bytes, no width
+  two_byte_angles.mutable_features()->mutable_keypoints()->set_angle_bytes(0);
+  EXPECT_THAT(decodeError(two_byte_angles), HasSubstr("keypoints.angle holds 10 bytes"));
+
+  v1::KeyFrame three_byte_angles = validKeyFrame();
+  three_byte_angles.mutable_features()->mutable_keypoints()->set_angle_bytes(3);
+  EXPECT_THAT(decodeError(three_byte_angles), HasSubstr("angle_bytes 3 is neither 1 nor 2"));
 
   v1::KeyFrame wide = validKeyFrame();
   wide.mutable_features()->mutable_keypoints()->set_coordinate_bytes(5);
