@@ -500,9 +500,7 @@ KeyFrame* Tracker::createKeyFrame(Frame& frame) {
       if (depth > options_.close_depth_m && created_or_existing > 100) break;
     }
   }
-  // The points it observes get their representative descriptor and normal refreshed where the
-  // keyframe is mapped (the local mapper, or the edge, whose slice brings them back): on the
-  // tracking thread that cost grows with the square of each point's observations.
+  for (MapPoint* p : kf->goodPoints()) map_.refreshPoint(p);
   map_.updateConnections(kf);
   remember(kf);
   reference_keyframe_ = kf;
