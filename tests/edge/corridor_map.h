@@ -8,18 +8,9 @@
 #include "geometry/camera.h"
 #include "map/map.h"
 #include "map/map_replication.h"
+#include "map/synthetic_views.h"
 
 namespace edgeslam::test {
-
-inline PinholeCamera corridorCamera() {
-  CameraIntrinsics in;
-  in.width = 640;
-  in.height = 480;
-  in.fx = in.fy = 500.0;
-  in.cx = 320.0;
-  in.cy = 240.0;
-  return PinholeCamera(in);
-}
 
 inline std::shared_ptr<FrameFeatures> corridorFeatures(const PinholeCamera& camera, int count) {
   auto features = std::make_shared<FrameFeatures>();
@@ -37,7 +28,7 @@ struct Corridor {
   static constexpr int kSpan = 40;
   static constexpr int kStep = 10;
 
-  PinholeCamera camera = corridorCamera();
+  PinholeCamera camera = syntheticCamera();
   Map map;
   std::vector<KeyFrame*> keyframes;
   std::vector<MapPoint*> points;  // by scene index

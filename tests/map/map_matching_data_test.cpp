@@ -18,76 +18,16 @@
 #include "geometry/pnp.h"
 #include "geometry/triangulation.h"
 #include "map/map_matching.h"
+#include "map/seven_scenes_frames.h"
 #include "support/shared_data.h"
 
 namespace edgeslam {
 namespace {
 
-const char* const kSequence = "datasets/7scenes-redkitchen-1000";
-
-PinholeCamera sevenScenesCamera() {
-  CameraIntrinsics in;
-  in.width = 640;
-  in.height = 480;
-  in.fx = in.fy = 585.0;
-  in.cx = 320.0;
-  in.cy = 240.0;
-  in.depth_factor = 1000.0;
-  return PinholeCamera(in);
-}
-
-std::string framePath(int index, const char* suffix) {
-  char name[64];
-  std::snprintf(name, sizeof(name), "/frame-%06d.%s", index, suffix);
-  return (test::sharedPath(kSequence).string() + name);
-}
-
-SE3d readCameraFromWorld(const std::string& path) {
-  std::ifstream in(path);
-  Eigen::Matrix4d T_wc;
-  for (int r = 0; r < 4; ++r) {
-    for (int c = 0; c < 4; ++c) {
-      if (!(in >> T_wc(r, c))) throw std::runtime_error("cannot read pose " + path);
-    }
-  }
-  return SE3d::fromMatrix(T_wc).inverse();
-}
-
-cv::Mat readDepthMetres(const std::string& path) {
-  const cv::Mat raw = cv::imread(path, cv::IMREAD_UNCHANGED);
-  if (raw.empty() || raw.type() != CV_16UC1) throw std::runtime_error("cannot read depth " + path);
-  cv::Mat metres(raw.size(), CV_32FC1);
-  for (int y = 0; y < raw.rows; ++y) {
-    for (int x = 0; x < raw.cols; ++x) {
-      const std::uint16_t d = raw.at<std::uint16_t>(y, x);
-      metres.at<float>(y, x) = d == 65535 ? 0.f : static_cast<float>(d) / 1000.f;
-    }
-  }
-  return metres;
-}
-
-struct RealFrame {
-  std::shared_ptr<const FrameFeatures> features;
-  SE3d T_cw;
-  cv::Mat depth;
-};
-
-// Frames are extracted once per process and shared by the tests.
+using test::sevenScenesCamera;
+using RealFrame = test::SevenScenesFrame;
 const RealFrame& realFrame(int index) {
-  static std::map<int, RealFrame> cache;
-  static const PinholeCamera camera = sevenScenesCamera();
-  static OrbExtractor extractor;
-  auto it = cache.find(index);
-  if (it == cache.end()) {
-    const cv::Mat grey = cv::imread(framePath(index, "color.jpg"), cv::IMREAD_GRAYSCALE);
-    if (grey.empty()) throw std::runtime_error("cannot read " + framePath(index, "color.jpg"));
-    RealFrame frame;
-    frame.depth = readDepthMetres(framePath(index, "depth.png"));
-    frame.features = buildFrameFeatures(grey, frame.depth, camera, extractor);
-    frame.T_cw = readCameraFromWorld(framePath(index, "pose.txt"));
-    it = cache.emplace(index, std::move(frame)).first;
-  }
-  return it->second;
+  return test::sevenScenesFrame(index);
 }
 
 Eigen::Vector3d pointFromDepth(const FrameFeatures& f, std::size_t i, const PinholeCamera& camera,
@@ -227,7 +167,7 @@ void time(const char* what, int runs, const std::function<void()>& setup,
 class MapMatchingRealData : public ::testing::Test {
  protected:
   void SetUp() override {
-    EDGESLAM_REQUIRE_SHARED(kSequence);
+    EDGESLAM_REQUIRE_SHARED(test::kSevenScenesSequence);
     kf0_ = keyFrameWithDepthPoints(map_, 0, poseOf(0, camera_), camera_);
   }
 

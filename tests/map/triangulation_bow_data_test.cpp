@@ -18,71 +18,19 @@
 #include "features/frame_features_builder.h"
 #include "features/orb_extractor.h"
 #include "map/map_matching.h"
+#include "map/seven_scenes_frames.h"
 #include "place/vocabulary_training.h"
 #include "support/shared_data.h"
 
 namespace edgeslam {
 namespace {
 
-const char* const kSequence = "datasets/7scenes-redkitchen-1000";
 constexpr int kFirst = 255, kSecond = 265;  // 4 cm and 1.5 degrees apart
 
-PinholeCamera sevenScenesCamera() {
-  CameraIntrinsics in;
-  in.width = 640;
-  in.height = 480;
-  in.fx = in.fy = 585.0;
-  in.cx = 320.0;
-  in.cy = 240.0;
-  in.depth_factor = 1000.0;
-  return PinholeCamera(in);
-}
-
-std::string framePath(int index, const char* suffix) {
-  return test::sharedPath(kSequence).string() + fmt::format("/frame-{:06d}.{}", index, suffix);
-}
-
-SE3d readCameraFromWorld(const std::string& path) {
-  std::ifstream in(path);
-  Eigen::Matrix4d T_wc;
-  for (int r = 0; r < 4; ++r) {
-    for (int c = 0; c < 4; ++c) {
-      if (!(in >> T_wc(r, c))) throw std::runtime_error("cannot read pose " + path);
-    }
-  }
-  return SE3d::fromMatrix(T_wc).inverse();
-}
-
-cv::Mat readDepthMetres(const std::string& path) {
-  const cv::Mat raw = cv::imread(path, cv::IMREAD_UNCHANGED);
-  if (raw.empty() || raw.type() != CV_16UC1) throw std::runtime_error("cannot read depth " + path);
-  cv::Mat metres;
-  raw.convertTo(metres, CV_32FC1, 1.0 / 1000.0);
-  metres.setTo(0.f, raw == 65535);
-  return metres;
-}
-
-struct RealFrame {
-  std::shared_ptr<const FrameFeatures> features;
-  SE3d T_cw;
-  cv::Mat depth;
-};
-
+using test::sevenScenesCamera;
+using RealFrame = test::SevenScenesFrame;
 const RealFrame& realFrame(int index) {
-  static std::map<int, RealFrame> cache;
-  static const PinholeCamera camera = sevenScenesCamera();
-  static OrbExtractor extractor;
-  auto it = cache.find(index);
-  if (it == cache.end()) {
-    const cv::Mat grey = cv::imread(framePath(index, "color.jpg"), cv::IMREAD_GRAYSCALE);
-    if (grey.empty()) throw std::runtime_error("cannot read " + framePath(index, "color.jpg"));
-    RealFrame frame;
-    frame.depth = readDepthMetres(framePath(index, "depth.png"));
-    frame.features = buildFrameFeatures(grey, frame.depth, camera, extractor);
-    frame.T_cw = readCameraFromWorld(framePath(index, "pose.txt"));
-    it = cache.emplace(index, std::move(frame)).first;
-  }
-  return it->second;
+  return test::sevenScenesFrame(index);
 }
 
 // k = 10, L = 4 on every 25th frame: the direct index at depth 2 has up to 100 nodes, as with the
@@ -92,8 +40,10 @@ const Vocabulary& vocabulary() {
     OrbExtractor extractor;
     std::vector<cv::Mat> training;
     for (int i = 0; i < 1000; i += 25) {
-      const cv::Mat grey = cv::imread(framePath(i, "color.jpg"), cv::IMREAD_GRAYSCALE);
-      if (grey.empty()) throw std::runtime_error("cannot read " + framePath(i, "color.jpg"));
+      const cv::Mat grey =
+          cv::imread(test::sevenScenesFramePath(i, "color.jpg"), cv::IMREAD_GRAYSCALE);
+      if (grey.empty())
+        throw std::runtime_error("cannot read " + test::sevenScenesFramePath(i, "color.jpg"));
       training.push_back(extractor.extract(grey).descriptors);
     }
     VocabularyTrainingOptions options;
@@ -166,7 +116,7 @@ double medianMs(int runs, const std::function<void()>& call) {
 class TriangulationByBowRealData : public ::testing::Test {
  protected:
   void SetUp() override {
-    EDGESLAM_REQUIRE_SHARED(kSequence);
+    EDGESLAM_REQUIRE_SHARED(test::kSevenScenesSequence);
     const RealFrame& a = realFrame(kFirst);
     const RealFrame& b = realFrame(kSecond);
     kf1_ = map_.createKeyFrame(kFirst, kFirst / 30.0, a.features, a.T_cw);
