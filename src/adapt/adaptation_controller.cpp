@@ -23,6 +23,12 @@ AdaptationController::AdaptationController(AdaptationOptions options)
       !(options_.min_margin_ms >= 0.0)) {
     throw std::invalid_argument("message_bytes and margins must be >= 0");
   }
+  if (options_.first_estimate_latency_samples >
+      std::max<std::size_t>(1, options_.estimator_window)) {
+    throw std::invalid_argument(
+        fmt::format("first_estimate_latency_samples {} exceeds the estimator window {}",
+                    options_.first_estimate_latency_samples, options_.estimator_window));
+  }
 }
 
 bool AdaptationController::onLatencyProbe(double rtt_ms, std::size_t wire_bytes) {
@@ -55,7 +61,12 @@ bool AdaptationController::observe(double n_ms) {
 
 bool AdaptationController::reevaluateLocked() {
   const auto n_ms = estimator_.networkTimeMs(options_.message_bytes);
-  return n_ms ? observeLocked(*n_ms) : false;
+  if (!n_ms) return false;
+  if (!has_estimate_ && estimator_.latencySampleCount() < options_.first_estimate_latency_samples) {
+    last_n_ms_ = *n_ms;
+    return false;
+  }
+  return observeLocked(*n_ms);
 }
 
 double AdaptationController::marginMs(double boundary_ms) const {

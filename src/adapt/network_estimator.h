@@ -26,6 +26,7 @@ class NetworkEstimator {
   bool addBandwidthProbe(std::size_t bytes, double elapsed_ms);
 
   std::optional<double> latencyMs() const;
+  std::size_t latencySampleCount() const { return latency_samples_.size(); }
   std::optional<double> bandwidthMbps() const;
   // N for a message of `message_bytes`, once both estimates exist.
   std::optional<double> networkTimeMs(double message_bytes) const;

@@ -38,9 +38,12 @@ TEST(AdaptationController, PicksTheRowOfNFromProbes) {
     const std::size_t bytes = 25000;
     const double elapsed = c.rtt_ms + bytes * 8.0 / (c.mbps * 1e3);
     controller.onBandwidthProbe(bytes, elapsed, bytes + 400);
+    EXPECT_EQ(controller.row(), kDefaultAdaptationRow);  // one latency sample is not enough
+    controller.onLatencyProbe(c.rtt_ms, 300);
+    controller.onLatencyProbe(c.rtt_ms, 300);
     EXPECT_EQ(controller.row(), c.expected_row) << "rtt " << c.rtt_ms << " B " << c.mbps;
     EXPECT_EQ(controller.config(), adaptationTable()[c.expected_row].config);
-    EXPECT_EQ(controller.probeBytes(), 300u + bytes + 400u);
+    EXPECT_EQ(controller.probeBytes(), 3 * 300u + bytes + 400u);
   }
 }
 
@@ -91,6 +94,23 @@ TEST(AdaptationController, FollowsALastingChangeAfterConfirmation) {
   EXPECT_EQ(controller.row(), 3u);
 }
 
+TEST(AdaptationController, ASlowFirstProbeDoesNotPickTheRow) {
+  // The first probe also opens the connection: 57 ms on a link whose RTT is 44 ms. Had it picked
+  // configuration 5, N = 47 ms would stay inside that row's hysteresis margin (50 - 5 ms) for good.
+  AdaptationOptions options;
+  options.message_bytes = 5000.0;
+  AdaptationController controller(options);
+  const std::size_t bytes = 40000;
+  const double bandwidth_mbps = 16.0;
+  controller.onLatencyProbe(57.0, 100);
+  controller.onBandwidthProbe(bytes, 44.0 + bytes * 8.0 / (bandwidth_mbps * 1e3), bytes);
+  controller.onLatencyProbe(44.0, 100);
+  EXPECT_EQ(controller.switches(), 0u);
+  controller.onLatencyProbe(44.5, 100);
+  EXPECT_EQ(controller.row(), 3u) << "N = " << controller.lastNetworkTimeMs().value_or(-1.0);
+  EXPECT_EQ(controller.switches(), 1u);
+}
+
 TEST(AdaptationController, CountsFramesPerConfiguration) {
   AdaptationController controller;
   controller.onFrame();
@@ -109,6 +129,9 @@ TEST(AdaptationController, RejectsBadOptions) {
   EXPECT_THROW(AdaptationController{options}, std::invalid_argument);
   options = {};
   options.confirm_count = 0;
+  EXPECT_THROW(AdaptationController{options}, std::invalid_argument);
+  options = {};
+  options.first_estimate_latency_samples = options.estimator_window + 1;
   EXPECT_THROW(AdaptationController{options}, std::invalid_argument);
   AdaptationController controller;
   EXPECT_THROW(controller.setMessageBytes(-1.0), std::invalid_argument);
