@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "segment_truth_score.h"
 #include "semantic/coco_classes.h"
 #include "semantic/label_encoding.h"
 #include "semantic/segmentation_overlay.h"
@@ -37,6 +38,8 @@ struct SegmentOptions {
   int threads = 0;
   int input_size = 512;
   int reduce = 1;
+  std::string truth;
+  int every = 1;
 };
 
 bool isImageFile(const fs::path& path) {
@@ -97,8 +100,9 @@ void segmentOne(Segmenter& segmenter, const fs::path& input, const fs::path& out
 }
 
 void runSegment(const SegmentOptions& o) {
-  if (o.image.empty() == o.images.empty()) {
-    throw std::invalid_argument("give exactly one of --image FILE or --images DIR");
+  if ((o.image.empty() ? 0 : 1) + (o.images.empty() ? 0 : 1) + (o.truth.empty() ? 0 : 1) != 1) {
+    throw std::invalid_argument(
+        "give exactly one of --image FILE, --images DIR or --truth GENERATED_SEQUENCE");
   }
   if (o.threads > 0) cv::setNumThreads(o.threads);
   SegmenterOptions options;
@@ -112,6 +116,10 @@ void runSegment(const SegmentOptions& o) {
   fmt::print("segmenter {} (models {}), classes {}, nm {:.2f}, score {:.2f}\n",
              segmenter->backendName(), options.model_dir.string(),
              classListToString(options.classes), o.nm, o.score);
+  if (!o.truth.empty()) {
+    scoreSegmenterOnSequence(*segmenter, o.truth, {o.every, o.reduce});
+    return;
+  }
   if (!o.image.empty()) {
     segmentOne(*segmenter, o.image, o.out, o);
     return;
@@ -134,6 +142,12 @@ void addSegmentCommand(CLI::App& app) {
       "draw overlays (coloured masks, boxes, labels)");
   segment->add_option("--image", options->image, "One input image (.png/.jpg)");
   segment->add_option("--images", options->images, "A folder: every .png/.jpg in it");
+  segment->add_option("--truth", options->truth,
+                      "A sequence made by `edgeslam synth-dynamic`: segment its frames and score "
+                      "them against its ground-truth masks (IoU, people missed, false alarms)");
+  segment->add_option("--every", options->every, "With --truth: score every Nth frame")
+      ->check(CLI::Range(1, 100000))
+      ->capture_default_str();
   segment->add_option("--out", options->out,
                       "Overlay PNG (with --image) or output folder (with --images); "
                       "nothing is written when absent");

@@ -34,16 +34,22 @@ void SemanticFrameFilter::offerMask(std::size_t frame_index, cv::Mat1b labels) {
       return;
     }
   }
+  spdlog::debug("mask of keyframe frame {} arrived at frame {} ({} frames late)", frame_index,
+                since.back().first, since.back().first - frame_index);
   CarriedMask carried;
   carried.keyframe_frame = frame_index;
   carried.frame = frame_index;
   carried.propagator = std::make_unique<MaskPropagator>(options_.propagation);
   carried.propagator->setReference(std::move(labels), since.front().second);
-  // Steps of at most catch_up_step frames, ending on the newest frame seen.
+  // A first step of one frame measures how each instance moves; then steps of at most
+  // catch_up_step frames, each searched around where that motion predicts the features, ending
+  // on the newest frame seen. (Without the first short step a person walking 15 px per frame is
+  // searched for around where they stood, and the mask is lost.)
   const std::size_t step = std::max<std::size_t>(1, options_.catch_up_step);
   for (std::size_t k = 1; k < since.size(); ++k) {
     const bool last = k + 1 == since.size();
-    if (!last && since[k].first - carried.frame < step) continue;
+    const bool first = carried.frame == frame_index;
+    if (!last && !first && since[k].first - carried.frame < step) continue;
     carried.propagator->propagate(*since[k].second, since[k].first - carried.frame);
     carried.frame = since[k].first;
   }

@@ -47,6 +47,9 @@ class MaskPropagator {
   // step spans as many frames as the last.
   std::array<cv::Matx23d, 256> warps_;
   std::array<cv::Matx23d, 256> previous_warps_;
+  // Labels whose last step was their own motion (fitted, or predicted from one): their
+  // constant-velocity prediction stands in when their matches fail.
+  std::array<bool, 256> has_own_motion_{};
   std::size_t last_step_frames_ = 0;
   TransferMatches last_matches_;
 };

@@ -80,9 +80,21 @@ TransferredInstance fitMotion(const std::vector<cv::Point2f>& from,
     dx.push_back(to[i].x - from[i].x);
     dy.push_back(to[i].y - from[i].y);
   }
+  const double tx = median(dx), ty = median(dy);
+  // The translation must rest on enough matches that agree with it: one or two stray matches
+  // (a person walking behind something) would otherwise throw the mask across the image.
+  const double tolerance = options.translation_agreement_px;
+  int agreeing = 0;
+  for (std::size_t i = 0; i < dx.size(); ++i) {
+    agreeing += std::hypot(dx[i] - tx, dy[i] - ty) <= tolerance ? 1 : 0;
+  }
+  if (agreeing < options.min_matches_for_translation ||
+      agreeing < options.min_inlier_ratio * static_cast<double>(dx.size())) {
+    return fit;
+  }
   fit.motion = InstanceMotion::kTranslation;
-  fit.warp = translation(median(dx), median(dy));
-  fit.inliers = fit.matches;
+  fit.warp = translation(tx, ty);
+  fit.inliers = agreeing;
   return fit;
 }
 
@@ -126,6 +138,8 @@ const char* toString(InstanceMotion motion) {
       return "translation";
     case InstanceMotion::kBackground:
       return "background";
+    case InstanceMotion::kPredicted:
+      return "predicted";
     case InstanceMotion::kIdentity:
       return "identity";
   }
@@ -170,7 +184,8 @@ MaskTransferResult transferLabels(const cv::Mat1b& keyframe_labels,
 MaskTransferResult transferLabels(const PreparedLabels& prepared,
                                   const std::vector<cv::Point2f>& keyframe_points,
                                   const std::vector<cv::Point2f>& current_points,
-                                  const MaskTransferOptions& options) {
+                                  const MaskTransferOptions& options,
+                                  const PredictedWarps* predicted) {
   const cv::Mat1b& keyframe_labels = prepared.labels;
   if (keyframe_points.size() != current_points.size()) {
     throw std::invalid_argument("mask transfer needs matched point lists of equal length, got " +
@@ -225,7 +240,12 @@ MaskTransferResult transferLabels(const PreparedLabels& prepared,
     to.clear();
     const auto& own = on_instance[static_cast<std::size_t>(label)];
     gather(own.empty() ? near_instance[static_cast<std::size_t>(label)] : own, from, to);
-    TransferredInstance moved = fitMotion(from, to, options, background_fallback);
+    TransferredInstance fallback = background_fallback;
+    if (predicted != nullptr && (*predicted)[static_cast<std::size_t>(label)]) {
+      fallback.motion = InstanceMotion::kPredicted;
+      fallback.warp = *(*predicted)[static_cast<std::size_t>(label)];
+    }
+    TransferredInstance moved = fitMotion(from, to, options, fallback);
     moved.label = static_cast<std::uint8_t>(label);
     paintWarped(keyframe_labels, moved.label, box, moved.warp, result.labels);
     result.instances.push_back(moved);

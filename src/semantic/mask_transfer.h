@@ -7,9 +7,13 @@
 //  - at least `min_matches_for_warp` matches: RANSAC similarity (rotation, uniform scale,
 //    translation) by cv::estimateAffinePartial2D; a fit with too few inliers or an implausible
 //    scale change falls back to the next rule;
-//  - at least one match: the median translation of those matches;
-//  - none: the background motion (a similarity fitted to the matches off every instance, or their
-//    median translation, or the identity when there are none).
+//  - at least `min_matches_for_translation` matches that agree (within
+//    `translation_agreement_px` of their median, and at least min_inlier_ratio of them): the median
+//    translation of those matches;
+//  - otherwise: the instance's predicted motion when the caller has one (its own motion carried on
+//    from the previous frames: a person walking out of the image, or behind something, keeps
+//    going), else the background motion (a similarity fitted to the matches off every instance,
+//    or their median translation, or the identity when there are none).
 // The instance's pixels are warped (nearest neighbour, inside their bounding box only, so the cost
 // follows the instance size) and painted into the current frame's label image.
 //
@@ -18,6 +22,7 @@
 #include <array>
 #include <cstdint>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <vector>
 
 namespace edgeslam {
@@ -25,6 +30,8 @@ namespace edgeslam {
 struct MaskTransferOptions {
   int near_margin_px = 12;       // matches this close to an instance count when none lies on it
   int min_matches_for_warp = 6;  // fewer: median translation instead of a similarity
+  int min_matches_for_translation = 3;
+  double translation_agreement_px = 6.0;
   double ransac_threshold_px = 3.0;
   double min_inlier_ratio = 0.5;  // of the matches used for the similarity
   double max_scale_change = 2.5;  // similarities scaling by more (or less than 1/this) are rejected
@@ -32,7 +39,7 @@ struct MaskTransferOptions {
   int merge_gap_px = 4;  // transferMask: mask fragments closer than this move as one instance
 };
 
-enum class InstanceMotion { kSimilarity, kTranslation, kBackground, kIdentity };
+enum class InstanceMotion { kSimilarity, kTranslation, kPredicted, kBackground, kIdentity };
 
 const char* toString(InstanceMotion motion);
 
@@ -70,11 +77,16 @@ MaskTransferResult transferLabels(const cv::Mat1b& keyframe_labels,
                                   const std::vector<cv::Point2f>& keyframe_points,
                                   const std::vector<cv::Point2f>& current_points,
                                   const MaskTransferOptions& options = {});
-// The same from prepared labels (prepared with options.near_margin_px).
+// Per label, the motion expected without matches (nullopt: none known).
+using PredictedWarps = std::array<std::optional<cv::Matx23d>, 256>;
+
+// The same from prepared labels (prepared with options.near_margin_px), with optional predicted
+// motions for the instances whose own matches do not settle it.
 MaskTransferResult transferLabels(const PreparedLabels& keyframe,
                                   const std::vector<cv::Point2f>& keyframe_points,
                                   const std::vector<cv::Point2f>& current_points,
-                                  const MaskTransferOptions& options = {});
+                                  const MaskTransferOptions& options = {},
+                                  const PredictedWarps* predicted = nullptr);
 
 // The same for a binary movable mask: its connected components (fragments closer than
 // `merge_gap_px` joined) are taken as the instances. Prefer transferLabels with the segmenter's

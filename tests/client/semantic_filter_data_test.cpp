@@ -60,8 +60,9 @@ TEST(SemanticFrameFilter, LateKeyframeMasksFollowThePeopleOnAGeneratedSequence) 
   ASSERT_TRUE(masks.has_value());
   OrbExtractor extractor;
   SemanticFrameFilter filter(reader->camera());
-  // Keyframes every 10 frames; each mask arrives 4 frames after its keyframe (the edge's delay).
-  constexpr std::size_t kKeyFrameEvery = 10, kMaskDelay = 4;
+  // Keyframes every 10 frames; each mask arrives 9 frames after its keyframe (the edge's delay
+  // measured on one core: 190 ms of segmentation plus the slice's way back).
+  constexpr std::size_t kKeyFrameEvery = 10, kMaskDelay = 9;
   SampleStats iou, client_ms;
   std::size_t on_people = 0, on_people_kept = 0;
   for (std::size_t i = 0; i < reader->info().frame_count; ++i) {

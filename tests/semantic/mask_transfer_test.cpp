@@ -48,6 +48,7 @@ struct Scene {
     }
     add({430, 250}, apply(walker, {430, 250}));
     add({460, 300}, apply(walker, {460, 300}));
+    add({445, 350}, apply(walker, {445, 350}));
     // Outliers on the person: gross mismatches RANSAC must reject.
     add({190, 200}, {500, 50});
     add({210, 300}, {20, 400});
@@ -100,8 +101,8 @@ TEST(MaskTransfer, WithoutMatchesTheMaskStaysWhereItWas) {
 
 TEST(MaskTransfer, FewBackgroundMatchesGiveTheirMedianTranslation) {
   const Scene scene;
-  const std::vector<cv::Point2f> from = {{20, 20}, {600, 400}, {30, 450}};
-  const std::vector<cv::Point2f> to = {{25, 22}, {605, 402}, {90, 300}};  // last one an outlier
+  const std::vector<cv::Point2f> from = {{20, 20}, {600, 400}, {300, 40}, {30, 450}};
+  const std::vector<cv::Point2f> to = {{25, 22}, {605, 402}, {305, 42}, {90, 300}};  // an outlier
   const MaskTransferResult result = transferLabels(scene.labels, from, to);
   EXPECT_EQ(result.background.motion, InstanceMotion::kTranslation);
   for (const auto& instance : result.instances) {
@@ -122,10 +123,31 @@ TEST(MaskTransfer, EmptyLabelsAndBadInput) {
 TEST(MaskTransfer, InstancesMovedOutOfTheImageDisappear) {
   cv::Mat1b labels = cv::Mat1b::zeros(100, 100);
   labels(cv::Rect(10, 10, 20, 20)).setTo(1);
-  const std::vector<cv::Point2f> from = {{15, 15}, {20, 20}};
-  const std::vector<cv::Point2f> to = {{515, 15}, {520, 20}};
+  const std::vector<cv::Point2f> from = {{15, 15}, {20, 20}, {25, 12}};
+  const std::vector<cv::Point2f> to = {{515, 15}, {520, 20}, {525, 12}};
   const MaskTransferResult result = transferLabels(labels, from, to);
   EXPECT_EQ(cv::countNonZero(result.labels), 0);
+}
+
+TEST(MaskTransfer, TooFewOrDisagreeingMatchesFallBackToThePredictedMotion) {
+  // A person walking behind something keeps two stray matches: they must not throw the mask
+  // across the image; the instance goes on with the motion its caller predicts.
+  cv::Mat1b labels = cv::Mat1b::zeros(480, 640);
+  labels(cv::Rect(100, 100, 60, 200)).setTo(1);
+  labels(cv::Rect(400, 100, 60, 200)).setTo(2);
+  const std::vector<cv::Point2f> from = {
+      {120, 150}, {140, 250}, {420, 150}, {430, 200}, {440, 250}};
+  const std::vector<cv::Point2f> to = {{320, 190}, {150, 240}, {430, 150}, {470, 230}, {400, 180}};
+  PredictedWarps predicted;
+  predicted[1] = cv::Matx23d(1, 0, 12, 0, 1, 0);
+  const MaskTransferResult result =
+      transferLabels(prepareLabels(labels, 12), from, to, {}, &predicted);
+  ASSERT_EQ(result.instances.size(), 2u);
+  EXPECT_EQ(result.instances[0].motion, InstanceMotion::kPredicted);
+  EXPECT_DOUBLE_EQ(result.instances[0].warp(0, 2), 12.0);
+  // Three matches that disagree, and no prediction: the background's motion (here none).
+  EXPECT_NE(result.instances[1].motion, InstanceMotion::kTranslation);
+  EXPECT_EQ(cv::countNonZero(result.labels == 2), 60 * 200);
 }
 
 }  // namespace
