@@ -21,6 +21,11 @@ KeyFrameDecision decideKeyFrame(const KeyFrameParameters& params, const KeyFrame
       e.frames_since_keyframe >= static_cast<std::size_t>(params.fmax)) {
     return KeyFrameDecision::kYesForced;
   }
+  if (params.segmentation_refresh > 0 &&
+      e.frames_since_keyframe >= static_cast<std::size_t>(params.segmentation_refresh) &&
+      e.mapper_accepts) {
+    return KeyFrameDecision::kYesForSegmentation;
+  }
   const bool rule1 = e.frames_since_keyframe > static_cast<std::size_t>(params.fmin) ||
                      e.keyframes_in_map < static_cast<std::size_t>(params.fmin);
   const bool rule4 = tracked_ratio < params.beta;

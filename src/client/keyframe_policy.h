@@ -13,6 +13,10 @@
 // A frame is a keyframe when (3) holds and either (1) and (4) hold, or (2) is violated.
 // Guard (why: with fmin = 10-40 frames, fast motion would lose tracking before the next keyframe is
 // allowed): when the tracked ratio falls below `starving_ratio`, rule (1) is waived.
+// Segmentation refresh (semantic culling on): people who walk into view appear in the movable mask
+// only once a keyframe showing them is segmented, so past `segmentation_refresh` frames since the
+// last keyframe a good frame becomes one (0 = off). On generated dynamic sequences keyframe gaps of
+// 17-26 frames left people unmasked for that long.
 #include <cstddef>
 
 namespace edgeslam {
@@ -24,6 +28,7 @@ struct KeyFrameParameters {
   double beta = 0.9;
   double starving_ratio = 0.35;
   int min_tracked = 15;  // never a keyframe from a frame that barely tracks
+  int segmentation_refresh = 0;
 };
 
 struct KeyFrameEvidence {
@@ -37,7 +42,7 @@ struct KeyFrameEvidence {
   bool mapper_accepts = true;         // false while the mapper is too busy to take one
 };
 
-enum class KeyFrameDecision { kNo, kYes, kYesForced, kYesStarving };
+enum class KeyFrameDecision { kNo, kYes, kYesForced, kYesStarving, kYesForSegmentation };
 
 KeyFrameDecision decideKeyFrame(const KeyFrameParameters& params, const KeyFrameEvidence& evidence);
 

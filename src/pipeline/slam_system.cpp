@@ -33,6 +33,13 @@ TrackingSlam::TrackingSlam(const PinholeCamera& camera, SlamOptions options,
   options_.mapper.monocular = options_.sensor == Sensor::kMonocular;
   if (options_.semantic) {
     semantic_filter_ = std::make_unique<SemanticFrameFilter>(camera_, options_.semantic_filter);
+    const double fps = camera_.intrinsics().fps;
+    const double rate = fps > 0 ? std::min(1.0, fps / 30.0) : 1.0;
+    options_.tracker.keyframes.segmentation_refresh =
+        options_.segmentation_refresh_frames <= 0
+            ? 0
+            : std::max(1,
+                       static_cast<int>(std::lround(options_.segmentation_refresh_frames * rate)));
   }
 }
 

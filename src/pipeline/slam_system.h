@@ -24,6 +24,9 @@ struct SlamOptions {
   Sensor sensor = Sensor::kMonocular;
   OrbExtractorOptions orb;
   TrackerOptions tracker;
+  // Edge mode, monocular: tracking triangulates new points at each keyframe (sets
+  // tracker.triangulate_at_keyframes) instead of waiting for the edge's; local mode ignores it.
+  bool client_triangulation = true;
   LocalMapperOptions mapper;
   DepthOptions depth;
   bool threaded_mapping = true;  // local mode, false: map each keyframe before the next frame
@@ -41,6 +44,9 @@ struct SlamOptions {
   SemanticFilterOptions semantic_filter;
   std::shared_ptr<Segmenter> segmenter;  // local mode
   int keyframe_image_reduce = 2;         // keyframes are segmented at 1/this of full size
+  // With semantic culling: at most this many frames (of a 30 fps camera) between keyframes, so
+  // that people walking into view are segmented soon (KeyFrameParameters::segmentation_refresh).
+  int segmentation_refresh_frames = 12;
 };
 
 // Sensible defaults for a camera: 1000 features up to 640x480-ish, 2000 for wide images (KITTI).

@@ -66,6 +66,24 @@ TEST(KeyFramePolicy, NeverFromABarelyTrackedFrame) {
   EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kNo);
 }
 
+TEST(KeyFramePolicy, SegmentationRefreshMakesAKeyFrameAfterItsGap) {
+  KeyFrameEvidence e = healthy();
+  e.frames_since_keyframe = 14;
+  e.frame_tracked = 310;  // the view barely changed: rule 4 says no
+  KeyFrameParameters p;
+  EXPECT_EQ(decideKeyFrame(p, e), KeyFrameDecision::kNo);
+  p.segmentation_refresh = 12;
+  EXPECT_EQ(decideKeyFrame(p, e), KeyFrameDecision::kYesForSegmentation);
+  e.mapper_accepts = false;
+  EXPECT_EQ(decideKeyFrame(p, e), KeyFrameDecision::kNo);
+  e.mapper_accepts = true;
+  e.frames_since_keyframe = 11;
+  EXPECT_EQ(decideKeyFrame(p, e), KeyFrameDecision::kNo);
+  e.frames_since_keyframe = 30;
+  e.frame_features = 300;  // a poor image is never one
+  EXPECT_EQ(decideKeyFrame(p, e), KeyFrameDecision::kNo);
+}
+
 TEST(KeyFramePolicy, TableIRowsChangeTheDecision) {
   KeyFrameEvidence e = healthy();
   e.frames_since_keyframe = 15;
