@@ -174,6 +174,7 @@ int runPipeline(const RunOptions& options) {
   slam_options.tracker.vocabulary = loadVocabulary(options.vocabulary);
   slam_options.vocabulary = slam_options.tracker.vocabulary;
   slam_options.loop_closing = options.loop_closing;
+  slam_options.client_triangulation = options.client_triangulation;
   if (options.triangulation_search) {
     slam_options.mapper.triangulation_search =
         *parseTriangulationSearch(*options.triangulation_search);
@@ -429,6 +430,12 @@ void addRunOptions(CLI::App* run, const std::shared_ptr<RunOptions>& options) {
       ->check(CLI::Range(0, 100000))
       ->capture_default_str();
   run->add_option("--loops", options->loop_closing, "Loop closing on|off (needs a vocabulary)")
+      ->transform(
+          CLI::CheckedTransformer(std::map<std::string, bool>{{"on", true}, {"off", false}}));
+  run->add_option("--client-triangulation", options->client_triangulation,
+                  "Edge mode, monocular: the client triangulates new points with its neighbour "
+                  "keyframes at each keyframe, so tracking need not wait for the edge's points "
+                  "(on|off, default on)")
       ->transform(
           CLI::CheckedTransformer(std::map<std::string, bool>{{"on", true}, {"off", false}}));
   run->add_option("--features", options->features,

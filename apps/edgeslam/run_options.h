@@ -29,6 +29,8 @@ struct RunOptions {
   // binary (vocab/orb_k10_l5.vocab) when present, "none" = without.
   std::string vocabulary;
   bool loop_closing = true;
+  // Edge mode, monocular: the client triangulates new points at its keyframes.
+  bool client_triangulation = true;
   // Edge mode: the client holds the features and points of about this many keyframes around its
   // latest one (the edge picks them and evicts the rest); 0 = the whole map.
   int client_map_keyframes = 10;

@@ -1,5 +1,6 @@
 #include "client/keyframe_places.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "place/bow_matching.h"
@@ -25,10 +26,16 @@ KeyFramePlaces::Indexed KeyFramePlaces::index(const FrameFeatures& features) con
   return out;
 }
 
-void KeyFramePlaces::add(const KeyFrame& keyframe) {
+std::shared_ptr<const KeyFramePlace> KeyFramePlaces::add(const KeyFrame& keyframe) {
   Indexed indexed = index(keyframe.features());
   database_.add(keyframe.id(), indexed.bow);
+  auto place = std::make_shared<KeyFramePlace>();
+  place->bow = std::move(indexed.bow);
+  place->features = indexed.direct;
+  place->direct_index_depth = std::max(0, vocabulary_->levels() - kDirectIndexLevelsUp);
+  place->vocabulary = vocabulary_.get();
   direct_index_[keyframe.id()] = std::move(indexed.direct);
+  return place;
 }
 
 void KeyFramePlaces::erase(KeyFrameId id) {

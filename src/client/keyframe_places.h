@@ -18,7 +18,9 @@ class KeyFramePlaces {
  public:
   explicit KeyFramePlaces(std::shared_ptr<const Vocabulary> vocabulary);
 
-  void add(const KeyFrame& keyframe);
+  // Returns the keyframe's description (bag of words and direct index), which the caller may
+  // attach to the keyframe (KeyFrame::setPlace) for bag-of-words triangulation.
+  std::shared_ptr<const KeyFramePlace> add(const KeyFrame& keyframe);
   // A keyframe the client no longer holds (evicted from its bounded map); no-op when unknown.
   void erase(KeyFrameId id);
   void clear();

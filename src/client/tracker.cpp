@@ -7,6 +7,7 @@
 
 #include "geometry/pnp.h"
 #include "map/map_matching.h"
+#include "map/pair_triangulation.h"
 #include "optimize/map_optimization.h"
 
 namespace edgeslam {
@@ -33,7 +34,13 @@ Tracker::Tracker(Map& map, const PinholeCamera& camera, TrackerOptions options, 
 }
 
 void Tracker::remember(KeyFrame* keyframe) {
-  if (places_ && keyframe != nullptr) places_->add(*keyframe);
+  if (!places_ || keyframe == nullptr) return;
+  std::shared_ptr<const KeyFramePlace> place = places_->add(*keyframe);
+  // Triangulation at keyframes searches pairs through the direct index (local mapping describes
+  // its keyframes its own way).
+  if (options_.triangulate_at_keyframes && keyframe->place() == nullptr) {
+    keyframe->setPlace(std::move(place));
+  }
 }
 
 void Tracker::onMapWindowChanged(const std::vector<KeyFrameId>& evicted,
@@ -503,10 +510,47 @@ KeyFrame* Tracker::createKeyFrame(Frame& frame) {
   for (MapPoint* p : kf->goodPoints()) map_.refreshPoint(p);
   map_.updateConnections(kf);
   remember(kf);
+  if (options_.triangulate_at_keyframes && options_.sensor == Sensor::kMonocular) {
+    triangulateAtKeyFrame(kf, frame);
+  }
   reference_keyframe_ = kf;
   last_keyframe_frame_ = frame.index;
   frame.reference_keyframe = kf;
   return kf;
+}
+
+void Tracker::triangulateAtKeyFrame(KeyFrame* keyframe, Frame& frame) {
+  Stopwatch timer;
+  std::size_t created = 0;
+  std::size_t band_searches = 0;
+  for (KeyFrame* neighbour : keyframe->bestCovisibles(options_.triangulation_neighbours)) {
+    if (neighbour->isBad() || neighbour->isEvicted()) continue;
+    // As local mapping: a baseline under 1 % of the scene depth triangulates nothing useful.
+    const double depth = neighbour->medianSceneDepth();
+    const double baseline = (neighbour->cameraCenter() - keyframe->cameraCenter()).norm();
+    if (depth <= 0.0 || baseline / depth < 0.01) continue;
+    const bool by_bow = canMatchForTriangulationByBow(*keyframe, *neighbour);
+    if (!by_bow && ++band_searches > options_.triangulation_neighbours_without_bow) continue;
+    // Without a bag of words on both sides this is the epipolar band search.
+    const auto pairs = matchForTriangulationByBow(*keyframe, *neighbour, camera_, true,
+                                                  options_.triangulation_ratio);
+    ++triangulation_.searches;
+    triangulation_.bow_searches += by_bow ? 1 : 0;
+    triangulation_.pairs += pairs.size();
+    for (const auto& [index, point] :
+         createPointsFromPairs(map_, keyframe, neighbour, pairs, camera_)) {
+      // The next frame finds it through the last frame (motion model) and the local map.
+      frame.points[index] = point;
+      frame.outliers[index] = false;
+      ++created;
+    }
+  }
+  if (created > 0) map_.updateConnections(keyframe);
+  triangulation_.points_created += created;
+  ++triangulation_.keyframes;
+  triangulation_.ms.add(timer.elapsedMs());
+  spdlog::debug("keyframe {} (frame {}): {} points triangulated on the client in {:.2f} ms",
+                keyframe->id(), frame.index, created, timer.elapsedMs());
 }
 
 void Tracker::record(const Frame& frame, bool tracked) {

@@ -16,6 +16,7 @@
 #include "geometry/camera.h"
 #include "map/frame.h"
 #include "map/map.h"
+#include "util/timing_stats.h"
 
 namespace edgeslam {
 
@@ -34,6 +35,26 @@ struct TrackerOptions {
   // without, it tries the most recent keyframes only.
   std::shared_ptr<const Vocabulary> vocabulary;
   std::size_t relocalization_candidates = 10;
+  // Monocular: each new keyframe triangulates new points with its best covisible keyframes right
+  // away, so that tracking has fresh points before any mapper's come back (edge mode, where the
+  // edge's points arrive a link round trip later). Local mode leaves it to local mapping.
+  bool triangulate_at_keyframes = false;
+  // Best covisible keyframes searched: through bag of words (a vocabulary: ~1 ms per keyframe
+  // pair on KITTI's 2000 features), else across the whole epipolar band (~6 ms per pair), so
+  // fewer then.
+  std::size_t triangulation_neighbours = 2;
+  std::size_t triangulation_neighbours_without_bow = 1;
+  float triangulation_ratio = 0.6f;  // best/second-best ratio of the pair search
+};
+
+// What triangulating at keyframes did (TrackerOptions::triangulate_at_keyframes).
+struct KeyFrameTriangulationStats {
+  std::size_t keyframes = 0;
+  std::size_t searches = 0;  // keyframe pairs searched
+  std::size_t bow_searches = 0;
+  std::size_t pairs = 0;  // keypoint pairs proposed
+  std::size_t points_created = 0;
+  SampleStats ms;  // per keyframe: search, triangulation and point creation
 };
 
 class Tracker {
@@ -67,6 +88,7 @@ class Tracker {
   std::size_t placesSize() const;
   std::size_t relocalizations() const { return relocalizations_; }
   std::size_t resets() const { return resets_; }
+  const KeyFrameTriangulationStats& triangulationStats() const { return triangulation_; }
 
  private:
   bool initialize(Frame& frame);
@@ -83,6 +105,7 @@ class Tracker {
   int discardOutliers(Frame& frame);
   KeyFrameDecision decide(const Frame& frame, int inliers) const;
   KeyFrame* createKeyFrame(Frame& frame);
+  void triangulateAtKeyFrame(KeyFrame* keyframe, Frame& frame);
   void record(const Frame& frame, bool tracked);
   void resetMap();
 
@@ -105,6 +128,7 @@ class Tracker {
   std::size_t relocalizations_ = 0;
   std::size_t resets_ = 0;
   std::size_t frames_lost_ = 0;
+  KeyFrameTriangulationStats triangulation_;
 };
 
 }  // namespace edgeslam

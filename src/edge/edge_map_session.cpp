@@ -76,6 +76,7 @@ void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
     }
     // The client already has what it sent: apply it without recording it for the slices.
     map_.setChangeRecording(false);
+    std::vector<UploadedPointConflict> conflicts;
     try {
       std::vector<MapPointRecord> new_points = upload.new_points;
       rebuildPositionsFromDepth(new_points, upload.keyframe, camera_);
@@ -84,13 +85,17 @@ void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
         if (map_.mapPoint(point.id) != nullptr) continue;
         // Normal, descriptor and distance range follow from the observations: the upload need
         // not carry them.
-        if (MapPoint* p = upsertPointRecord(map_, point, upload.keyframe.id)) map_.refreshPoint(p);
+        if (auto conflict = insertUploadedPoint(map_, point, upload.keyframe.id)) {
+          conflicts.push_back(*conflict);
+        }
       }
     } catch (...) {
       map_.setChangeRecording(true);
       throw;
     }
     map_.setChangeRecording(true);
+    // Where the edge's map differs from what the client sent, the slices say so.
+    resolveUploadedPointConflicts(map_, conflicts);
     window_.clientHolds(keyframe->id());
     std::lock_guard state(state_mutex_);
     ++stats_.uploads;

@@ -6,9 +6,8 @@
 #include <chrono>
 #include <cmath>
 
-#include "geometry/chi_square.h"
-#include "geometry/triangulation.h"
 #include "map/map_matching.h"
+#include "map/pair_triangulation.h"
 
 namespace edgeslam {
 
@@ -261,16 +260,12 @@ void LocalMapper::createNewPoints(KeyFrame* keyframe) {
   std::size_t searches = 0, bow_searches = 0, proposed = 0;
   double search_ms = 0.0;
   const FrameFeatures& f1 = keyframe->features();
-  const ScaleLevels& scales = f1.scales;
-  const double ratio_factor = 1.5 * scales.scaleFactor();
   std::size_t created = 0;
 
   for (KeyFrame* neighbour : neighbours) {
     if (hasPending() && created > 0) break;
     std::lock_guard lock(map_.updateMutex());
     if (neighbour->isBad() || keyframe->isBad()) continue;
-    const SE3d T1 = keyframe->pose();
-    const SE3d T2 = neighbour->pose();
     const Eigen::Vector3d c1 = keyframe->cameraCenter();
     const Eigen::Vector3d c2 = neighbour->cameraCenter();
     const double baseline = (c2 - c1).norm();
@@ -292,53 +287,9 @@ void LocalMapper::createNewPoints(KeyFrame* keyframe) {
     ++searches;
     bow_searches += by_bow ? 1 : 0;
     proposed += pairs.size();
-    const FrameFeatures& f2 = neighbour->features();
-    for (const auto& [i1, i2] : pairs) {
-      if (keyframe->point(i1) != nullptr || neighbour->point(i2) != nullptr) continue;
-      const cv::KeyPoint& kp1 = f1.keypoints[i1];
-      const cv::KeyPoint& kp2 = f2.keypoints[i2];
-      const Eigen::Vector2d px1(kp1.pt.x, kp1.pt.y), px2(kp2.pt.x, kp2.pt.y);
-      const Eigen::Vector3d ray1 = T1.rotation().conjugate() * camera_.unproject(px1).normalized();
-      const Eigen::Vector3d ray2 = T2.rotation().conjugate() * camera_.unproject(px2).normalized();
-      const double ray_cos = ray1.dot(ray2);
-      const bool depth1 = f1.hasDepth(i1), depth2 = f2.hasDepth(i2);
-      // Parallax a stereo/depth measurement would give, to decide between rays and depth.
-      const double depth_cos1 =
-          depth1 ? std::cos(2 * std::atan2(f1.bf / camera_.fx() / 2, f1.depth[i1])) : 1.1;
-      const double depth_cos2 =
-          depth2 ? std::cos(2 * std::atan2(f2.bf / camera_.fx() / 2, f2.depth[i2])) : 1.1;
-      const double depth_cos = std::min(depth_cos1, depth_cos2);
-
-      std::optional<Eigen::Vector3d> x;
-      if (ray_cos > 0 && ray_cos < depth_cos && (depth1 || depth2 || ray_cos < 0.9998)) {
-        x = triangulateDlt(T1, camera_.unproject(px1).head<2>(), T2,
-                           camera_.unproject(px2).head<2>());
-      } else if (depth1 && depth_cos1 < depth_cos2) {
-        x = keyframe->poseInverse() * (camera_.unproject(px1) * f1.depth[i1]);
-      } else if (depth2 && depth_cos2 < depth_cos1) {
-        x = neighbour->poseInverse() * (camera_.unproject(px2) * f2.depth[i2]);
-      }
-      if (!x || !x->allFinite()) continue;
-      if (!isInFrontOfBoth(T1, T2, *x)) continue;
-      // Reprojection in both keyframes, at each keypoint's level.
-      const double error1 =
-          reprojectionErrorSquared(camera_, T1, *x, px1) * scales.invSigma2(kp1.octave);
-      const double error2 =
-          reprojectionErrorSquared(camera_, T2, *x, px2) * f2.scales.invSigma2(kp2.octave);
-      if (error1 > chi2::k2Dof95 || error2 > chi2::k2Dof95) continue;
-      // Scale consistency: distance ratio must agree with the pyramid level ratio.
-      const double dist1 = (*x - c1).norm(), dist2 = (*x - c2).norm();
-      if (dist1 <= 0 || dist2 <= 0) continue;
-      const double ratio_dist = dist2 / dist1;
-      const double ratio_octave = scales.scale(kp1.octave) / f2.scales.scale(kp2.octave);
-      if (ratio_dist * ratio_factor < ratio_octave || ratio_dist > ratio_octave * ratio_factor) {
-        continue;
-      }
-      MapPoint* p = map_.createMapPoint(*x, keyframe);
-      map_.addObservation(p, keyframe, i1);
-      map_.addObservation(p, neighbour, i2);
-      map_.refreshPoint(p);
-      recent_points_.push_back(p);
+    for (const auto& [index, point] :
+         createPointsFromPairs(map_, keyframe, neighbour, pairs, camera_)) {
+      recent_points_.push_back(point);
       ++created;
     }
   }

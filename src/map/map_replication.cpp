@@ -1,5 +1,6 @@
 #include "map/map_replication.h"
 
+#include <algorithm>
 #include <cstring>
 #include <stdexcept>
 
@@ -109,14 +110,33 @@ KeyFrame* insertKeyFrameRecord(Map& map, const KeyFrameRecord& record,
   return keyframe;
 }
 
+namespace {
+
+// A point this side made in a keyframe the sender had not received yet (a monocular client
+// triangulating with an older keyframe): the sender's records cannot know it, so they do not take
+// its keypoints; the sender settles the clash when that keyframe arrives there
+// (resolveUploadedPointConflicts).
+bool unknownToSender(const MapPoint* point, KeyFrameId newest_known_to_sender) {
+  const KeyFrameId born = point->firstKeyFrameId();
+  return born != kInvalidId && idOrigin(born) == idOrigin(newest_known_to_sender) &&
+         born > newest_known_to_sender;
+}
+
+}  // namespace
+
 MapPoint* upsertPointRecord(Map& map, const MapPointRecord& record,
                             KeyFrameId newest_known_to_sender) {
   std::vector<std::pair<KeyFrame*, std::size_t>> observers;
   for (const PointObservationRecord& obs : record.observations) {
     KeyFrame* kf = map.keyFrame(obs.keyframe);
     // size() is 0 for an evicted keyframe: observations there are not held.
-    if (kf != nullptr && obs.keypoint_index < kf->size())
-      observers.emplace_back(kf, obs.keypoint_index);
+    if (kf == nullptr || obs.keypoint_index >= kf->size()) continue;
+    const MapPoint* there = kf->point(obs.keypoint_index);
+    if (there != nullptr && there->id() != record.id && !there->isBad() &&
+        unknownToSender(there, newest_known_to_sender)) {
+      continue;
+    }
+    observers.emplace_back(kf, obs.keypoint_index);
   }
   MapPoint* point = map.mapPoint(record.id);
   std::vector<KeyFrame*> dropped;
@@ -154,6 +174,65 @@ MapPoint* upsertPointRecord(Map& map, const MapPointRecord& record,
   map.setPointAppearance(point, record.normal, descriptor, record.min_distance,
                          record.max_distance);
   return point;
+}
+
+std::optional<UploadedPointConflict> insertUploadedPoint(Map& map, const MapPointRecord& record,
+                                                         KeyFrameId uploaded_keyframe) {
+  MapPointRecord applied = record;
+  MapPoint* occupant = nullptr;
+  bool dropped = false;
+  std::erase_if(applied.observations, [&](const PointObservationRecord& obs) {
+    if (obs.keyframe == uploaded_keyframe) return false;
+    const KeyFrame* kf = map.keyFrame(obs.keyframe);
+    // A later keyframe of the sender (not here yet) links the point when it arrives.
+    if (kf == nullptr && idOrigin(obs.keyframe) == idOrigin(uploaded_keyframe) &&
+        obs.keyframe > uploaded_keyframe) {
+      return false;
+    }
+    if (kf == nullptr || obs.keypoint_index >= kf->size()) {
+      dropped = true;
+      return true;
+    }
+    MapPoint* there = kf->point(obs.keypoint_index);
+    if (there != nullptr && !there->isBad() && there->id() != record.id) {
+      if (occupant == nullptr) occupant = there;
+      dropped = true;
+      return true;
+    }
+    return false;
+  });
+  MapPoint* point = upsertPointRecord(map, applied, uploaded_keyframe);
+  if (point == nullptr) return std::nullopt;
+  map.refreshPoint(point);
+  if (!dropped) return std::nullopt;
+  return UploadedPointConflict{point, occupant};
+}
+
+namespace {
+
+// Records the point as updated, so that the next slice carries all of it (observations too): the
+// client's copy differs in more than the changes recorded here show.
+void sendAgain(Map& map, MapPoint* point) {
+  map.setPointAppearance(point, point->normal(), point->descriptor(), point->baseMinDistance(),
+                         point->baseMaxDistance());
+}
+
+}  // namespace
+
+void resolveUploadedPointConflicts(Map& map, const std::vector<UploadedPointConflict>& conflicts) {
+  for (const UploadedPointConflict& c : conflicts) {
+    if (c.point->isBad()) continue;
+    if (c.occupant != nullptr && !c.occupant->isBad()) {
+      map.replacePoint(c.point, c.occupant);
+      // The client may lack the occupant's observation on the contested keypoint (its own point
+      // held it there, upsertPointRecord), even where the merge itself changes nothing.
+      if (!c.occupant->isBad()) sendAgain(map, c.occupant);
+    } else if (c.point->observationCount() <= 2) {
+      map.erasePoint(c.point);
+    } else {
+      sendAgain(map, c.point);
+    }
+  }
 }
 
 namespace {

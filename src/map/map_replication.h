@@ -1,7 +1,9 @@
 #pragma once
 // Between map elements and their wire records, both ways. The callers hold the map's update mutex.
 #include <memory>
+#include <optional>
 #include <unordered_set>
+#include <vector>
 
 #include "geometry/camera.h"
 #include "map/map.h"
@@ -26,10 +28,30 @@ KeyFrame* insertKeyFrameRecord(Map& map, const KeyFrameRecord& record, const Pin
 // Creates or updates a point so that its position, appearance and its observations among the
 // keyframes this map has match the record. Observations in keyframes newer than
 // `newest_known_to_sender` (same id origin) are kept: the sender could not know them. Observations
-// in evicted keyframes are not held. Returns nullptr when none of the observing keyframes is here
-// (nothing to attach it to).
+// in evicted keyframes are not held, nor those on a keypoint that holds a point this side made in
+// a keyframe newer than `newest_known_to_sender` (the sender will settle that clash). Returns
+// nullptr when none of the observing keyframes is here (nothing to attach it to).
 MapPoint* upsertPointRecord(Map& map, const MapPointRecord& record,
                             KeyFrameId newest_known_to_sender);
+
+// A new point of a client's keyframe upload, on the edge. The point may be seen in older keyframes
+// of the client too (monocular clients triangulate with their neighbours), which the edge may have
+// changed since the client saw them: such a keypoint may hold a point of the edge's own (mapped
+// before the client had it) or the keyframe may be gone. Those observations are not applied (the
+// edge's point keeps its keypoint), and what differs from the client's map is returned, to be
+// settled by resolveUploadedPointConflicts once the map records changes again. Call with change
+// recording off (the client has what it sent); refreshes the point. nullopt: applied as sent (or
+// not attached at all, as upsertPointRecord).
+struct UploadedPointConflict {
+  MapPoint* point = nullptr;     // as applied
+  MapPoint* occupant = nullptr;  // the edge's point on one of its keypoints, if any
+};
+std::optional<UploadedPointConflict> insertUploadedPoint(Map& map, const MapPointRecord& record,
+                                                         KeyFrameId uploaded_keyframe);
+// With change recording on: a point whose keypoint held another point merges into that one
+// (Map::replacePoint, as fusion would); one that only lost observations is erased when that left
+// it as weak as Map::eraseObservation would (the client erases it then) or sent again.
+void resolveUploadedPointConflicts(Map& map, const std::vector<UploadedPointConflict>& conflicts);
 
 // Uploads of RGB-D keyframes. The sender flags a new point whose position is the back-projection
 // of its first observation in `keyframe` (within 0.1 mm), so that the wire can leave it out...

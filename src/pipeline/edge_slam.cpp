@@ -18,6 +18,7 @@ EdgeSlam::EdgeSlam(const PinholeCamera& camera, SlamOptions options, std::unique
   sink_options.camera = camera_;
   sink_ = std::make_unique<EdgeKeyFrameSink>(map_, *link_, sink_options);
   link_->setSliceHandler([this](MapSlice slice) { onSlice(std::move(slice)); });
+  options_.tracker.triangulate_at_keyframes = options_.client_triangulation;
   startTracking(sink_.get());
   if (adaptation && link_->edgeClient() != nullptr) {
     adaptation_ = std::make_unique<AdaptationLoop>(*link_->edgeClient(), *adaptation);
@@ -28,6 +29,15 @@ EdgeSlam::EdgeSlam(const PinholeCamera& camera, SlamOptions options, std::unique
 EdgeSlam::~EdgeSlam() {
   if (adaptation_) adaptation_->stop();  // it probes through the link's client
   link_->close();
+  const KeyFrameTriangulationStats& t = tracker_->triangulationStats();
+  if (t.keyframes > 0) {
+    const PercentileSummary ms = t.ms.summary();
+    spdlog::info(
+        "client triangulation: {} keyframes, {} searches ({} by bag of words), {} pairs, {} points "
+        "created; {:.2f} ms median, {:.2f} ms p90, {:.2f} ms max per keyframe",
+        t.keyframes, t.searches, t.bow_searches, t.pairs, t.points_created, ms.median, ms.p90,
+        ms.max);
+  }
 }
 
 void EdgeSlam::beforeTracking(std::size_t frame_index, const cv::Mat& image) {
