@@ -316,6 +316,15 @@ int runPipeline(const RunOptions& options) {
                              {"max_points", c.max_points},
                              {"keyframes_evicted", c.keyframes_evicted},
                              {"keyframes_entered", c.keyframes_entered}};
+    const KeyFrameTriangulationStats& t = edge_slam->clientTriangulation();
+    if (t.keyframes > 0) {
+      const PercentileSummary ms = t.ms.summary();
+      metrics["client_triangulation"] = {{"keyframes", t.keyframes},
+                                         {"points_created", t.points_created},
+                                         {"ms_per_keyframe", {{"median", ms.median},
+                                                              {"p90", ms.p90},
+                                                              {"max", ms.max}}}};
+    }
   }
   if (options.semantic || semantic_eval) {
     nlohmann::json semantic = {{"enabled", options.semantic},

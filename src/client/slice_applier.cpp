@@ -1,5 +1,7 @@
 #include "client/slice_applier.h"
 
+#include <vector>
+
 #include "map/map_replication.h"
 
 namespace edgeslam {
@@ -43,10 +45,28 @@ SliceApplyResult applySlice(Map& map, const MapSlice& slice, const PinholeCamera
       ++result.keyframes_moved;
     }
   }
+  std::vector<KeyFrame*> observers_before;
+  const auto observersOf = [](const MapPoint& p, std::vector<KeyFrame*>& out) {
+    out.clear();
+    for (const auto& [kf_id, obs] : p.observations()) out.push_back(obs.keyframe);
+  };
+  std::vector<KeyFrame*> observers_after;
   for (const MapPointRecord& record : slice.points_upserted) {
-    if (MapPoint* p = upsertPointRecord(map, record, slice.newest_keyframe)) {
-      for (const auto& [kf_id, obs] : p->observations()) touched.insert(obs.keyframe);
+    // Covisibility changes only where a point's observers do: most upserts of a known point only
+    // refresh its position and appearance, and re-linking every keyframe they touch was most of
+    // a slice's cost on the client.
+    const MapPoint* before = map.mapPoint(record.id);
+    observers_before.clear();
+    if (before != nullptr) observersOf(*before, observers_before);
+    MapPoint* p = upsertPointRecord(map, record, slice.newest_keyframe);
+    observers_after.clear();
+    if (p != nullptr) {
+      observersOf(*p, observers_after);
       ++result.points_upserted;
+    }
+    if (observers_after != observers_before) {
+      touched.insert(observers_before.begin(), observers_before.end());
+      touched.insert(observers_after.begin(), observers_after.end());
     }
   }
   for (const PointPositionRecord& record : slice.point_positions) {

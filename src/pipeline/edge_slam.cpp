@@ -52,6 +52,10 @@ void EdgeSlam::noteClientMapSize(std::size_t keyframes, std::size_t points) {
   client_map_.max_points = std::max(client_map_.max_points, points);
 }
 
+const KeyFrameTriangulationStats& EdgeSlam::clientTriangulation() const {
+  return tracker_->triangulationStats();
+}
+
 ClientMapSize EdgeSlam::clientMapSize() const {
   std::size_t keyframes = 0, points = 0;
   {

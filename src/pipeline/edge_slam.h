@@ -42,6 +42,8 @@ class EdgeSlam : public TrackingSlam {
   std::size_t keyFrameCount() const override;
   std::size_t mapPointCount() const override;
   ClientMapSize clientMapSize() const;
+  // Points the client triangulated itself (monocular); read once the run is over.
+  const KeyFrameTriangulationStats& clientTriangulation() const;
 
   double finish_timeout_s = 30.0;
 
