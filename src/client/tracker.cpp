@@ -327,7 +327,11 @@ int Tracker::matchForRelocalization(KeyFrame& candidate, Frame& frame) {
 }
 
 bool Tracker::relocalize(Frame& frame) {
+  const Stopwatch timer;
   for (KeyFrame* kf : relocalizationCandidates(frame)) {
+    // Candidates come best first; a frame that has spent its budget gives up, and the next
+    // frame tries again.
+    if (timer.elapsedMs() > options_.relocalization_budget_ms) break;
     if (matchForRelocalization(*kf, frame) < 15) continue;
     std::vector<Eigen::Vector2d> pixels;
     std::vector<Eigen::Vector3d> points;
@@ -361,6 +365,7 @@ bool Tracker::relocalize(Frame& frame) {
       return true;
     }
   }
+  spdlog::debug("frame {}: not relocalised ({:.1f} ms)", frame.index, timer.elapsedMs());
   std::fill(frame.points.begin(), frame.points.end(), nullptr);
   frame.T_cw.reset();
   return false;
