@@ -47,6 +47,11 @@ bool EdgeKeyFrameSink::acceptsKeyFrames() const {
   return sequence_.load() - answered_.load() < options_.max_in_flight;
 }
 
+bool EdgeKeyFrameSink::acceptsUrgentKeyFrames() const {
+  return sequence_.load() - answered_.load() <
+         options_.max_in_flight + options_.urgent_extra_in_flight;
+}
+
 void EdgeKeyFrameSink::onMapReset() {
   std::lock_guard lock(map_.updateMutex());
   reset_pending_ = true;

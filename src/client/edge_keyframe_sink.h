@@ -19,6 +19,10 @@ namespace edgeslam {
 struct EdgeKeyFrameSinkOptions {
   // Tracking holds back optional keyframes while this many uploads wait for their slice.
   std::size_t max_in_flight = 3;
+  // Starving tracking may have this many more in flight (below the link's queue of 8, so none
+  // is dropped for it): behind a congested link the edge answers seconds late, and a monocular
+  // client refused its keyframes lost tracking for good at the first fast turn.
+  std::size_t urgent_extra_in_flight = 3;
   // With the camera, new points that are the depth back-projection of their keypoint in the
   // uploaded keyframe are flagged so that the wire leaves their positions out (~12 bytes each).
   std::optional<PinholeCamera> camera;
@@ -30,6 +34,7 @@ class EdgeKeyFrameSink : public KeyFrameSink {
 
   void insertKeyFrame(KeyFrame* keyframe) override;
   bool acceptsKeyFrames() const override;
+  bool acceptsUrgentKeyFrames() const override;
   std::size_t lastOptimizedFrame() const override { return last_optimized_frame_.load(); }
   void onMapReset() override;
 

@@ -15,7 +15,7 @@ KeyFrameDecision decideKeyFrame(const KeyFrameParameters& params, const KeyFrame
           ? 0.0
           : static_cast<double>(e.frame_tracked) / static_cast<double>(e.reference_tracked);
   const bool starving = tracked_ratio < params.starving_ratio;
-  if (starving && e.mapper_accepts) return KeyFrameDecision::kYesStarving;
+  if (starving && e.mapper_accepts_urgent) return KeyFrameDecision::kYesStarving;
 
   if (e.frames_since_map_update >= static_cast<std::size_t>(params.fmax) ||
       e.frames_since_keyframe >= static_cast<std::size_t>(params.fmax)) {

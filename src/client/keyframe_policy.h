@@ -40,6 +40,7 @@ struct KeyFrameEvidence {
   std::size_t frame_tracked = 0;      // inlier matches to map points in this frame
   std::size_t reference_tracked = 0;  // points of the reference keyframe seen by >= 2 keyframes
   bool mapper_accepts = true;         // false while the mapper is too busy to take one
+  bool mapper_accepts_urgent = true;  // the same for a keyframe of starving tracking
 };
 
 enum class KeyFrameDecision { kNo, kYes, kYesForced, kYesStarving, kYesForSegmentation };

@@ -474,6 +474,7 @@ KeyFrameDecision Tracker::decide(const Frame& frame, int inliers) const {
   const int min_obs = e.keyframes_in_map <= 2 ? 2 : 3;
   e.reference_tracked = static_cast<std::size_t>(reference_keyframe_->trackedPointCount(min_obs));
   e.mapper_accepts = sink_ == nullptr || sink_->acceptsKeyFrames();
+  e.mapper_accepts_urgent = sink_ == nullptr || sink_->acceptsUrgentKeyFrames();
   const KeyFrameDecision decision = decideKeyFrame(options_.keyframes, e);
   spdlog::debug(
       "frame {}: keyframe decision {} (since kf {}, since map update {}, kfs {}, features {}/{}, "

@@ -13,6 +13,9 @@ class KeyFrameSink {
   virtual void insertKeyFrame(KeyFrame* keyframe) = 0;
   // False while the mapper has a backlog: tracking then holds back optional keyframes.
   virtual bool acceptsKeyFrames() const = 0;
+  // Whether a keyframe tracking cannot do without (it is starving) may still go in: a little
+  // more backlog than acceptsKeyFrames() allows, bounded all the same.
+  virtual bool acceptsUrgentKeyFrames() const { return acceptsKeyFrames(); }
   // Index of the frame whose keyframe was last optimised into the map (keyframe rule 2).
   virtual std::size_t lastOptimizedFrame() const = 0;
   // The map was emptied (a failed start): forget queued keyframes.

@@ -55,7 +55,9 @@ TEST(KeyFramePolicy, StarvingTrackingWaivesFmin) {
   KeyFrameEvidence e = healthy();
   e.frame_tracked = 80;  // 80 / 320 = 0.25 < 0.35
   EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kYesStarving);
-  e.mapper_accepts = false;
+  e.mapper_accepts = false;  // busy, but it still takes an urgent one
+  EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kYesStarving);
+  e.mapper_accepts_urgent = false;
   EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kNo);
 }
 
