@@ -31,21 +31,21 @@ std::shared_ptr<const KeyFramePlace> KeyFramePlaces::add(const KeyFrame& keyfram
   database_.add(keyframe.id(), indexed.bow);
   auto place = std::make_shared<KeyFramePlace>();
   place->bow = std::move(indexed.bow);
-  place->features = indexed.direct;
+  place->features = std::move(indexed.direct);
   place->direct_index_depth = std::max(0, vocabulary_->levels() - kDirectIndexLevelsUp);
   place->vocabulary = vocabulary_.get();
-  direct_index_[keyframe.id()] = std::move(indexed.direct);
+  places_[keyframe.id()] = place;
   return place;
 }
 
 void KeyFramePlaces::erase(KeyFrameId id) {
   database_.erase(id);
-  direct_index_.erase(id);
+  places_.erase(id);
 }
 
 void KeyFramePlaces::clear() {
   database_.clear();
-  direct_index_.clear();
+  places_.clear();
   query_features_ = nullptr;
 }
 
@@ -64,12 +64,12 @@ std::vector<KeyFrameId> KeyFramePlaces::similar(const FrameFeatures& frame, std:
 }
 
 std::vector<cv::DMatch> KeyFramePlaces::match(const KeyFrame& keyframe) const {
-  const auto it = direct_index_.find(keyframe.id());
-  if (it == direct_index_.end() || query_features_ == nullptr) return {};
+  const auto it = places_.find(keyframe.id());
+  if (it == places_.end() || query_features_ == nullptr) return {};
   const FrameFeatures& frame = *query_features_;
   const FrameFeatures& kf = keyframe.features();
-  return matchByBow(query_.direct, frame.keypoints, frame.descriptors, it->second, kf.keypoints,
-                    kf.descriptors);
+  return matchByBow(query_.direct, frame.keypoints, frame.descriptors, it->second->features,
+                    kf.keypoints, kf.descriptors);
 }
 
 }  // namespace edgeslam

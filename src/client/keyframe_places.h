@@ -24,7 +24,7 @@ class KeyFramePlaces {
   // A keyframe the client no longer holds (evicted from its bounded map); no-op when unknown.
   void erase(KeyFrameId id);
   void clear();
-  std::size_t size() const { return direct_index_.size(); }
+  std::size_t size() const { return places_.size(); }
 
   // Indexes a frame to look up, and returns the ids of the stored keyframes most similar to it,
   // best first, at most `max_results`, none scoring under `relative_min` times the best.
@@ -43,7 +43,8 @@ class KeyFramePlaces {
 
   std::shared_ptr<const Vocabulary> vocabulary_;
   KeyFrameDatabase database_;
-  std::unordered_map<KeyFrameId, FeatureVector> direct_index_;
+  // Each keyframe's description, shared with the keyframe where the tracker attaches it.
+  std::unordered_map<KeyFrameId, std::shared_ptr<const KeyFramePlace>> places_;
   // The frame being looked up, indexed once for all its candidates.
   const FrameFeatures* query_features_ = nullptr;
   Indexed query_;

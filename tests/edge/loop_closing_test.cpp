@@ -14,6 +14,7 @@
 #include "pipeline/local_slam.h"
 #include "place/vocabulary_training.h"
 #include "support/shared_data.h"
+#include "support/small_vocabulary.h"
 
 namespace edgeslam {
 namespace {
@@ -23,23 +24,8 @@ constexpr const char* kKitti = "datasets/kitti07-160";
 
 // A small vocabulary (k=10, L=4) from 50 images of both sequences, trained once per test process.
 std::shared_ptr<const Vocabulary> testVocabulary() {
-  static const std::shared_ptr<const Vocabulary> vocabulary = [] {
-    OrbExtractor extractor;
-    std::vector<cv::Mat> descriptors;
-    const auto add = [&](const char* dataset, std::size_t step) {
-      auto reader = openDataset(test::sharedPath(dataset));
-      for (std::size_t i = 0; i < reader->info().frame_count; i += step) {
-        descriptors.push_back(extractor.extract(reader->load(i).gray).descriptors);
-      }
-    };
-    add(kSevenScenes, 25);
-    add(kKitti, 16);
-    VocabularyTrainingOptions options;
-    options.branching = 10;
-    options.levels = 4;
-    options.threads = 2;
-    return std::make_shared<const Vocabulary>(trainVocabulary(descriptors, options));
-  }();
+  static const std::shared_ptr<const Vocabulary> vocabulary = std::make_shared<const Vocabulary>(
+      test::trainSmallVocabulary({{kSevenScenes, 25}, {kKitti, 16}}));
   return vocabulary;
 }
 

@@ -16,6 +16,7 @@
 #include "pipeline/edge_slam.h"
 #include "place/vocabulary_training.h"
 #include "support/shared_data.h"
+#include "support/small_vocabulary.h"
 
 namespace edgeslam {
 namespace {
@@ -24,21 +25,8 @@ constexpr const char* kKitti = "datasets/kitti07-160";
 
 // A small vocabulary (k=10, L=4) from every 10th frame of the sequence, trained once per process.
 std::shared_ptr<const Vocabulary> kittiVocabulary() {
-  static const std::shared_ptr<const Vocabulary> vocabulary = [] {
-    auto reader = openDataset(test::sharedPath(kKitti));
-    OrbExtractorOptions orb;
-    orb.num_features = 2000;
-    OrbExtractor extractor(orb);
-    std::vector<cv::Mat> descriptors;
-    for (std::size_t i = 0; i < reader->info().frame_count; i += 10) {
-      descriptors.push_back(extractor.extract(reader->load(i).gray).descriptors);
-    }
-    VocabularyTrainingOptions options;
-    options.branching = 10;
-    options.levels = 4;
-    options.threads = 2;
-    return std::make_shared<const Vocabulary>(trainVocabulary(descriptors, options));
-  }();
+  static const std::shared_ptr<const Vocabulary> vocabulary =
+      std::make_shared<const Vocabulary>(test::trainSmallVocabulary({{kKitti, 10}}, 2000));
   return vocabulary;
 }
 

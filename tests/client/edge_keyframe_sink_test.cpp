@@ -1,0 +1,47 @@
+#include "client/edge_keyframe_sink.h"
+
+#include <gtest/gtest.h>
+
+#include <vector>
+
+#include "map/synthetic_views.h"
+
+namespace edgeslam {
+namespace {
+
+class RecordingUplink final : public KeyFrameUplink {
+ public:
+  void send(KeyFrameUpload upload) override { sent.push_back(upload.sequence); }
+  std::vector<std::uint64_t> sent;
+};
+
+TEST(EdgeKeyFrameSink, StarvingTrackingMayHaveAFewMoreUploadsInFlight) {
+  Map map;
+  RecordingUplink uplink;
+  EdgeKeyFrameSinkOptions options;
+  options.max_in_flight = 3;
+  options.urgent_extra_in_flight = 2;
+  EdgeKeyFrameSink sink(map, uplink, options);
+  const auto features = test::emptyFeatures(test::syntheticCamera());
+  const auto upload = [&](std::size_t frame) {
+    sink.insertKeyFrame(map.createKeyFrame(frame, 0.0, features, SE3d()));
+  };
+  for (std::size_t frame = 0; frame < 3; ++frame) {
+    EXPECT_TRUE(sink.acceptsKeyFrames());
+    upload(frame);
+  }
+  EXPECT_FALSE(sink.acceptsKeyFrames());  // 3 unanswered
+  EXPECT_TRUE(sink.acceptsUrgentKeyFrames());
+  upload(3);
+  upload(4);
+  EXPECT_FALSE(sink.acceptsUrgentKeyFrames());  // 5 unanswered: the urgent bound too
+  sink.onSliceApplied(2, 1);                    // the edge answered the first two: 3 left
+  EXPECT_TRUE(sink.acceptsUrgentKeyFrames());
+  EXPECT_FALSE(sink.acceptsKeyFrames());
+  sink.onSliceApplied(5, 4);
+  EXPECT_TRUE(sink.acceptsKeyFrames());
+  EXPECT_EQ(uplink.sent.size(), 5u);
+}
+
+}  // namespace
+}  // namespace edgeslam
