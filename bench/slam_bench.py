@@ -1,6 +1,8 @@
 #!/usr/bin/env python3
 """SLAM accuracy/speed benchmark: the issue's reference rows, each run N times, in each run mode.
 
+Frames are fed at the dataset's rate (--feed realtime, the default), as ORB-SLAM2's example programs
+feed them when its reference times were taken; --feed fast feeds them back to back.
 local: the whole run pinned to one core. edge / offload: an `edgeslam server` process pinned to core 1
 and the `edgeslam client` pinned to core 0, over loopback gRPC (as the edge issue asks).
 Prints a markdown table (median of the runs and [min-max] spread) and writes it to docs/benchmarks.md
@@ -32,9 +34,10 @@ def pinned(cmd, cpu):
     return cmd if cpu is None else ["taskset", "-c", str(cpu)] + cmd
 
 
-def run_once(binary, dataset, sensor, mode, cpu, port):
+def run_once(binary, dataset, sensor, mode, cpu, port, feed):
     with tempfile.TemporaryDirectory() as out:
-        common = ["--dataset", dataset, "--sensor", sensor, "--mode", mode, "--out", out]
+        common = ["--dataset", dataset, "--sensor", sensor, "--mode", mode, "--out", out,
+                  f"--{feed}"]
         server = None
         if mode == "local":
             cmd = pinned([binary, "run"] + common, cpu)
@@ -70,6 +73,8 @@ def main():
     parser.add_argument("--modes", default="local", help="comma list of local, edge, offload")
     parser.add_argument("--port", type=int, default=50151)
     parser.add_argument("--cpu", default="0", help="core to pin to; 'none' for no pinning")
+    parser.add_argument("--feed", default="realtime", choices=["realtime", "fast"],
+                        help="realtime: frames at the dataset's rate; fast: back to back")
     parser.add_argument("--no-docs", action="store_true")
     args = parser.parse_args()
     binary = os.path.join(args.build, "edgeslam")
@@ -89,7 +94,7 @@ def main():
         runs = []
         for i in range(args.runs):
             print(f"{key} {mode}: run {i + 1}/{args.runs}", file=sys.stderr, flush=True)
-            runs.append(run_once(binary, dataset, sensor, mode, cpu, args.port))
+            runs.append(run_once(binary, dataset, sensor, mode, cpu, args.port, args.feed))
         ate = [100 * r["ate_final"]["rmse_m"] for r in runs if "ate_final" in r]
         ate_t = [100 * r["ate"]["rmse_m"] for r in runs if "ate" in r]
         tracked = [r["tracked"] for r in runs]

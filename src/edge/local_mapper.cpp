@@ -8,6 +8,7 @@
 
 #include "map/map_matching.h"
 #include "map/pair_triangulation.h"
+#include "util/thread_priority.h"
 
 namespace edgeslam {
 
@@ -123,6 +124,10 @@ void LocalMapper::processAll() {
 }
 
 void LocalMapper::run() {
+  if (!lowerCurrentThreadPriority(options_.thread_nice)) {
+    spdlog::warn("local mapping: could not lower the thread's priority by {}",
+                 options_.thread_nice);
+  }
   while (true) {
     KeyFrame* kf = nullptr;
     {

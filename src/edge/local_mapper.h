@@ -55,6 +55,8 @@ struct LocalMapperOptions {
   // culling those as unobserved.
   bool observe_recent_points = false;
   bool cull_keyframes = true;
+  // Nice increment for the mapping thread (util/thread_priority.h); 0 leaves it as it is.
+  int thread_nice = 0;
 };
 
 struct LocalMapperStats {

@@ -5,6 +5,7 @@
 #include <exception>
 
 #include "edge/loop_global_ba.h"
+#include "util/thread_priority.h"
 #include "util/timing_stats.h"
 
 namespace edgeslam {
@@ -95,6 +96,9 @@ void LoopCloser::waitUntilIdle() {
 }
 
 void LoopCloser::run() {
+  if (!lowerCurrentThreadPriority(options_.thread_nice)) {
+    spdlog::warn("loop closing: could not lower the thread's priority by {}", options_.thread_nice);
+  }
   while (true) {
     KeyFrame* keyframe = nullptr;
     {

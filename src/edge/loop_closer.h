@@ -32,6 +32,8 @@ struct LoopCloserOptions {
   bool threaded = true;
   bool global_ba = true;
   int global_ba_iterations = 10;
+  // Nice increment for the loop-closing and global-BA threads (util/thread_priority.h).
+  int thread_nice = 0;
   // No search while the map is this small, nor within this many keyframes of the last loop.
   std::size_t min_map_keyframes = 10;
   std::size_t min_keyframes_since_loop = 10;

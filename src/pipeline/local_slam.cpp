@@ -10,6 +10,7 @@ LocalSlam::LocalSlam(const PinholeCamera& camera, SlamOptions options)
     : TrackingSlam(camera, std::move(options), 0) {
   // The session's vocabulary serves the mapper's bag-of-words triangulation search too.
   if (!options_.mapper.vocabulary) options_.mapper.vocabulary = options_.vocabulary;
+  options_.mapper.thread_nice = options_.background_nice;
   mapper_ = std::make_unique<LocalMapper>(map_, camera_, options_.mapper);
   if (options_.vocabulary != nullptr && options_.loop_closing) {
     LoopCloserOptions loop = options_.loop_closer;
@@ -17,6 +18,7 @@ LocalSlam::LocalSlam(const PinholeCamera& camera, SlamOptions options)
     loop.verifier.fix_scale = for_sensor.verifier.fix_scale;
     loop.correction.fix_scale = for_sensor.correction.fix_scale;
     loop.threaded = options_.threaded_mapping;
+    loop.thread_nice = options_.background_nice;
     loop_closer_ =
         std::make_unique<LoopCloser>(map_, camera_, options_.vocabulary, loop, mapper_.get());
     mapper_->setKeyFrameMappedCallback([this](KeyFrame* kf) { loop_closer_->insertKeyFrame(kf); });

@@ -30,6 +30,10 @@ struct SlamOptions {
   LocalMapperOptions mapper;
   DepthOptions depth;
   bool threaded_mapping = true;  // local mode, false: map each keyframe before the next frame
+  // Local mode: nice increment of the mapping and loop-closing threads, so that on a shared core
+  // a frame is tracked before the background work (util/thread_priority.h). Worth it when frames
+  // come at a camera's pace; with frames fed back to back the mapper would fall behind.
+  int background_nice = 0;
   // Loop closing runs where the global map is mapped (local mode: in-process; edge mode: on the
   // edge) when a vocabulary is given and it is switched on.
   std::shared_ptr<const Vocabulary> vocabulary;
@@ -48,6 +52,9 @@ struct SlamOptions {
   // that people walking into view are segmented soon (KeyFrameParameters::segmentation_refresh).
   int segmentation_refresh_frames = 12;
 };
+
+// Nice 10 gives a thread about a tenth of the CPU against a nice-0 one.
+inline constexpr int kBackgroundNiceWhenPaced = 10;
 
 // Sensible defaults for a camera: 1000 features up to 640x480-ish, 2000 for wide images (KITTI).
 SlamOptions defaultSlamOptions(const PinholeCamera& camera, Sensor sensor);
