@@ -131,6 +131,7 @@ std::unique_ptr<SlamSystem> makeSlamSystem(const RunOptions& options, const std:
   }
   EdgeClientOptions client_options;
   client_options.keyframe_image.downscale = options.segment_reduce;
+  client_options.omit_known_point_descriptors = options.omit_known_point_descriptors;
   auto link = std::make_unique<GrpcEdgeLink>(edge.address, config, client_options);
   AdaptationLoopOptions adaptation;
   adaptation.adapt = options.adapt;
@@ -175,6 +176,9 @@ int runPipeline(const RunOptions& options) {
   slam_options.vocabulary = slam_options.tracker.vocabulary;
   slam_options.loop_closing = options.loop_closing;
   slam_options.client_triangulation = options.client_triangulation;
+  // Paced frames have a deadline and the background has the time between them; unpaced (--fast)
+  // tracking always has work, so lowering the mapper would starve it of keyframes.
+  slam_options.background_nice = options.realtime ? kBackgroundNiceWhenPaced : 0;
   if (options.triangulation_search) {
     slam_options.mapper.triangulation_search =
         *parseTriangulationSearch(*options.triangulation_search);
@@ -319,11 +323,10 @@ int runPipeline(const RunOptions& options) {
     const KeyFrameTriangulationStats& t = edge_slam->clientTriangulation();
     if (t.keyframes > 0) {
       const PercentileSummary ms = t.ms.summary();
-      metrics["client_triangulation"] = {{"keyframes", t.keyframes},
-                                         {"points_created", t.points_created},
-                                         {"ms_per_keyframe", {{"median", ms.median},
-                                                              {"p90", ms.p90},
-                                                              {"max", ms.max}}}};
+      metrics["client_triangulation"] = {
+          {"keyframes", t.keyframes},
+          {"points_created", t.points_created},
+          {"ms_per_keyframe", {{"median", ms.median}, {"p90", ms.p90}, {"max", ms.max}}}};
     }
   }
   if (options.semantic || semantic_eval) {
@@ -467,6 +470,12 @@ void addRunOptions(CLI::App* run, const std::shared_ptr<RunOptions>& options) {
                   "Local mapping's new-point search: bow (direct index, needs a vocabulary) or "
                   "band (whole epipolar band); default bow")
       ->check(CLI::IsMember({"bow", "band"}))
+      ->group("Advanced");
+  run->add_option("--upload-descriptors", options->omit_known_point_descriptors,
+                  "Edge mode: descriptors a keyframe upload carries: new (leave out those of "
+                  "keypoints whose point the edge has; it substitutes the point's) or all")
+      ->transform(
+          CLI::CheckedTransformer(std::map<std::string, bool>{{"new", true}, {"all", false}}))
       ->group("Advanced");
 }
 

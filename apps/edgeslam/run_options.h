@@ -34,6 +34,8 @@ struct RunOptions {
   // Edge mode: the client holds the features and points of about this many keyframes around its
   // latest one (the edge picks them and evicts the rest); 0 = the whole map.
   int client_map_keyframes = 10;
+  // Edge mode: uploads leave out the descriptors of keypoints whose point the edge already has.
+  bool omit_known_point_descriptors = true;
   // Tuning; unset values keep the defaults (Table I row 1 for local tracking).
   std::optional<int> features;
   std::optional<int> levels;

@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "edge/movable_points.h"
+#include "edge/omitted_descriptors.h"
 #include "edge/slice_builder.h"
 #include "map/map_replication.h"
 #include "semantic/label_encoding.h"
@@ -46,6 +47,13 @@ EdgeMapSession::EdgeMapSession(const PinholeCamera& camera, Sensor sensor,
 
 EdgeMapSession::~EdgeMapSession() {
   stop();
+  const EdgeMapSessionStats totals = stats();
+  if (totals.descriptors_filled + totals.descriptors_lost > 0) {
+    spdlog::info(
+        "edge session: {} uploaded keypoints took their map point's descriptor, {} lost theirs "
+        "(point gone)",
+        totals.descriptors_filled, totals.descriptors_lost);
+  }
 }
 
 void EdgeMapSession::stop() {
@@ -74,13 +82,28 @@ void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
       window_.clear();
       window_centre_ = kInvalidId;
     }
+    // Descriptors the wire left out are those of points this map has (or had).
+    const KeyFrameRecord* record = &upload.keyframe;
+    KeyFrameRecord filled;
+    OmittedDescriptorFill fill;
+    if (!upload.keyframe.features.descriptor_omitted.empty()) {
+      filled = upload.keyframe;
+      fill = fillOmittedDescriptors(map_, filled);
+      record = &filled;
+      if (!fill.lost.empty()) {
+        spdlog::debug(
+            "keyframe {:#x}: {} keypoints name points this map no longer has and came without "
+            "descriptors: they keep neither (first: keypoint {})",
+            filled.id, fill.lost.size(), fill.lost.front());
+      }
+    }
     // The client already has what it sent: apply it without recording it for the slices.
     map_.setChangeRecording(false);
     std::vector<UploadedPointConflict> conflicts;
     try {
       std::vector<MapPointRecord> new_points = upload.new_points;
-      rebuildPositionsFromDepth(new_points, upload.keyframe, camera_);
-      keyframe = insertKeyFrameRecord(map_, upload.keyframe, camera_);
+      rebuildPositionsFromDepth(new_points, *record, camera_);
+      keyframe = insertKeyFrameRecord(map_, *record, camera_);
       for (const MapPointRecord& point : new_points) {
         if (map_.mapPoint(point.id) != nullptr) continue;
         // Normal, descriptor and distance range follow from the observations: the upload need
@@ -99,6 +122,8 @@ void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
     window_.clientHolds(keyframe->id());
     std::lock_guard state(state_mutex_);
     ++stats_.uploads;
+    stats_.descriptors_filled += fill.filled;
+    stats_.descriptors_lost += fill.lost.size();
     upload_of_keyframe_[keyframe->id()] = upload.sequence;
     newest_keyframe_ = keyframe->id();
   }

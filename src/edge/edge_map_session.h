@@ -44,6 +44,10 @@ struct EdgeMapSessionStats {
   std::uint64_t client_keyframes_held = 0;  // bounded client map: as the edge counts them
   std::uint64_t client_keyframes_evicted = 0;
   std::uint64_t client_keyframes_resent = 0;  // sent back into the window
+  // Uploaded keypoints whose descriptor the wire left out: filled from their map point, or lost
+  // (the point was gone: the keypoint keeps neither point nor descriptor).
+  std::uint64_t descriptors_filled = 0;
+  std::uint64_t descriptors_lost = 0;
 };
 
 class EdgeMapSession {
@@ -56,8 +60,10 @@ class EdgeMapSession {
   EdgeMapSession(const EdgeMapSession&) = delete;
   EdgeMapSession& operator=(const EdgeMapSession&) = delete;
 
-  // Adds the keyframe and its new points to the global map and queues it for mapping. Throws
-  // std::invalid_argument for records that contradict themselves.
+  // Adds the keyframe and its new points to the global map and queues it for mapping. Descriptors
+  // the upload left out (features.descriptor_omitted) are those of the points their keypoints
+  // name (fillOmittedDescriptors). Throws std::invalid_argument for records that contradict
+  // themselves.
   void onKeyFrame(const KeyFrameUpload& upload);
   // Waits until every queued keyframe is mapped and its slice published.
   void finish();

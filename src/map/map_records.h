@@ -41,8 +41,12 @@ struct MapPointRecord {
 struct KeyFrameFeaturesRecord {
   std::vector<cv::KeyPoint> keypoints;  // undistorted, octave = pyramid level
   cv::Mat descriptors;                  // N x 32 CV_8U
-  std::vector<float> depth;             // empty, or one per keypoint (<= 0 unknown)
-  std::vector<float> right_u;           // empty, or one per keypoint
+  // Decoded keyframe uploads only: per keypoint, true where the wire left the descriptor out (its
+  // row is zero) because the keypoint's point is one the edge already has; the edge fills the row
+  // from that point before the keyframe enters its map. Empty: every row present.
+  std::vector<bool> descriptor_omitted;
+  std::vector<float> depth;    // empty, or one per keypoint (<= 0 unknown)
+  std::vector<float> right_u;  // empty, or one per keypoint
   int pyramid_levels = 8;
   double scale_factor = 1.2;
   float bf = 0.f;

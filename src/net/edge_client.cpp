@@ -60,6 +60,7 @@ struct EdgeClient::Impl {
         options(std::move(client_options)) {
     options.upload_queue_capacity = std::max<std::size_t>(options.upload_queue_capacity, 1);
     encode_options.keypoint_response = options.send_keypoint_response;
+    encode_options.omit_known_point_descriptors = options.omit_known_point_descriptors;
     channel = grpc::CreateCustomChannel(
         address, grpc::InsecureChannelCredentials(),
         clientChannelArguments(options.max_receive_message_bytes,
@@ -216,6 +217,18 @@ struct EdgeClient::Impl {
       try {
         compressKeyFrameImage(upload, options.keyframe_image);
         toProto(upload, request.mutable_upload(), encode_options);
+        if (encode_options.omit_known_point_descriptors &&
+            spdlog::should_log(spdlog::level::debug)) {
+          WireEncodeOptions every_descriptor = encode_options;
+          every_descriptor.omit_known_point_descriptors = false;
+          const v1::KeyFrameFeatures& features = request.upload().keyframe().features();
+          spdlog::debug(
+              "edge client: upload {}: {} bytes ({} with every descriptor); {} keypoints, {} "
+              "associations, {} new points, {} descriptors sent",
+              upload.sequence, wireSize(request.upload()), wireSize(upload, every_descriptor),
+              features.keypoints().count(), request.upload().keyframe().point_id_deltas_size(),
+              upload.new_points.size(), features.descriptors().size() / 32);
+        }
       } catch (const std::exception& e) {
         spdlog::error("edge client: upload {} cannot be encoded: {}", upload.sequence, e.what());
         finishUpload(false, true);

@@ -22,7 +22,8 @@ class EdgeSessionBackend {
  public:
   virtual ~EdgeSessionBackend() = default;
   // A new keyframe, in increasing upload sequence (gaps are uploads the client dropped; retries
-  // of an upload already passed on are filtered out).
+  // of an upload already passed on are filtered out). Descriptors the client left out (keypoints
+  // of points the edge has) are zero rows flagged in keyframe.features.descriptor_omitted.
   virtual void onKeyFrame(KeyFrameUpload upload) = 0;
   // A whole frame in offload mode. nullopt: this backend does not track frames (the client gets
   // UNIMPLEMENTED).

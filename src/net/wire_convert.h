@@ -26,6 +26,11 @@ struct WireEncodeOptions {
   // Bytes per keypoint angle: 1 (1.4-degree steps; ORB matching compares orientations in
   // 12-degree bins) or 2.
   int angle_bytes = 1;
+  // Keyframe uploads: keypoints associated with a point the edge already has (not one of the
+  // upload's new points) travel without their descriptor (32 bytes each); the edge takes the
+  // point's. Off here so that a plain round trip is lossless; the client turns it on
+  // (EdgeClientOptions::omit_known_point_descriptors).
+  bool omit_known_point_descriptors = false;
 };
 
 void toProto(const SE3d& pose, v1::Pose* out);
@@ -43,11 +48,15 @@ void toProto(const OffloadFrame& frame, v1::OffloadFrameRequest* out);
 void toProto(const OffloadResult& result, v1::OffloadFrameReply* out);
 
 SE3d fromProto(const v1::Pose& pose);
+// A keyframe of a slice: every descriptor present (one with descriptors left out, which only an
+// upload may do, is a WireError).
 KeyFrameRecord fromProto(const v1::KeyFrame& keyframe);
 // Points sent without appearance decode with zero normal, descriptor and distance range.
 std::vector<MapPointRecord> fromProto(const v1::MapPoints& points);
 std::vector<PointPositionRecord> fromProto(const v1::PointPositions& positions);
 std::vector<KeyFramePoseRecord> fromProto(const v1::KeyFramePoses& poses);
+// Descriptors the upload left out decode as zero rows flagged in
+// keyframe.features.descriptor_omitted (the edge fills them from its points).
 KeyFrameUpload fromProto(const v1::KeyFrameUpload& upload);
 MaskRecord fromProto(const v1::Mask& mask);
 MapSlice fromProto(const v1::MapSlice& slice);

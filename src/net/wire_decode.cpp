@@ -1,5 +1,6 @@
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -156,6 +157,36 @@ std::vector<float> decodeDepth(const v1::KeyFrameFeatures& in, std::size_t n) {
   return out;
 }
 
+// Descriptors come last: which rows travel follows from the point associations. `omitted`: per
+// keypoint, whether its row was left out (empty: none was); those decode as zero rows.
+void decodeDescriptors(const std::string& bytes, const std::vector<bool>& omitted,
+                       KeyFrameFeaturesRecord& out) {
+  const std::size_t n = out.keypoints.size();
+  std::size_t sent = n;
+  if (!omitted.empty())
+    sent -= static_cast<std::size_t>(std::count(omitted.begin(), omitted.end(), true));
+  if (bytes.size() != sent * kDescriptorBytes) {
+    if (omitted.empty()) {
+      throw WireError(fmt::format("descriptors hold {} bytes, expected 32 x {} keypoints = {}",
+                                  bytes.size(), n, n * kDescriptorBytes));
+    }
+    throw WireError(fmt::format(
+        "descriptors hold {} bytes, expected 32 x {} keypoints = {} ({} of the {} keypoints "
+        "name a point the edge has and travel without theirs)",
+        bytes.size(), sent, sent * kDescriptorBytes, n - sent, n));
+  }
+  out.descriptors =
+      cv::Mat::zeros(static_cast<int>(n), static_cast<int>(kDescriptorBytes), CV_8UC1);
+  std::size_t next = 0;
+  for (std::size_t row = 0; row < n; ++row) {
+    if (!omitted.empty() && omitted[row]) continue;
+    std::memcpy(out.descriptors.ptr<std::uint8_t>(static_cast<int>(row)),
+                bytes.data() + next * kDescriptorBytes, kDescriptorBytes);
+    ++next;
+  }
+  out.descriptor_omitted = omitted;
+}
+
 KeyFrameFeaturesRecord decodeFeatures(const v1::KeyFrameFeatures& in) {
   KeyFrameFeaturesRecord out;
   if (in.pyramid_levels() < 1 ||
@@ -174,12 +205,6 @@ KeyFrameFeaturesRecord decodeFeatures(const v1::KeyFrameFeatures& in) {
   out.keypoints =
       decodeKeyPoints(in.keypoints(), ScaleLevels(out.pyramid_levels, out.scale_factor));
   const std::size_t n = out.keypoints.size();
-  if (in.descriptors().size() != n * kDescriptorBytes) {
-    throw WireError(fmt::format("descriptors hold {} bytes, expected 32 x {} keypoints = {}",
-                                in.descriptors().size(), n, n * kDescriptorBytes));
-  }
-  out.descriptors.create(static_cast<int>(n), static_cast<int>(kDescriptorBytes), CV_8UC1);
-  if (n > 0) std::memcpy(out.descriptors.data, in.descriptors().data(), n * kDescriptorBytes);
   out.depth = decodeDepth(in, n);
   if (in.right_u_from_depth()) {
     if (in.right_u_size() != 0) throw WireError("right_u both sent and to be rebuilt from depth");
@@ -237,7 +262,12 @@ SE3d fromProto(const v1::Pose& pose) {
   return SE3d(q, t);  // normalises
 }
 
-KeyFrameRecord fromProto(const v1::KeyFrame& in) {
+namespace {
+
+// `new_points`: the ids of the upload's new points, when the keyframe comes in an upload (whose
+// keypoints naming other points may travel without their descriptor); nullptr elsewhere.
+KeyFrameRecord decodeKeyFrame(const v1::KeyFrame& in,
+                              const std::unordered_set<MapPointId>* new_points) {
   return within(fmt::format("keyframe {}", idText(in.id())), [&] {
     KeyFrameRecord out;
     requireId(in.id(), "id");
@@ -267,8 +297,34 @@ KeyFrameRecord fromProto(const v1::KeyFrame& in) {
       out.point_ids[index] = id;
       next_index = index + 1;
     }
+    std::vector<bool> omitted;
+    if (in.known_point_descriptors_omitted()) {
+      if (new_points == nullptr) {
+        throw WireError(
+            "known_point_descriptors_omitted is set, but only a keyframe upload may leave "
+            "descriptors out");
+      }
+      omitted.assign(n, false);
+      bool any = false;
+      for (std::size_t i = 0; i < n; ++i) {
+        omitted[i] = out.point_ids[i] != kInvalidId && !new_points->contains(out.point_ids[i]);
+        any = any || omitted[i];
+      }
+      if (!any) {
+        throw WireError(
+            "known_point_descriptors_omitted is set, but no keypoint names a point other than "
+            "the upload's new points");
+      }
+    }
+    decodeDescriptors(in.features().descriptors(), omitted, out.features);
     return out;
   });
+}
+
+}  // namespace
+
+KeyFrameRecord fromProto(const v1::KeyFrame& in) {
+  return decodeKeyFrame(in, nullptr);
 }
 
 std::vector<MapPointRecord> fromProto(const v1::MapPoints& in) {
@@ -409,13 +465,16 @@ KeyFrameUpload fromProto(const v1::KeyFrameUpload& in) {
     if (in.sequence() == 0) throw WireError("sequence is 0 (sequences start at 1)");
     out.sequence = in.sequence();
     if (!in.has_keyframe()) throw WireError("keyframe is missing");
-    out.keyframe = fromProto(in.keyframe());
+    out.new_points = within("new points", [&] { return fromProto(in.new_points()); });
+    std::unordered_set<MapPointId> new_point_ids;
+    new_point_ids.reserve(out.new_points.size());
+    for (const MapPointRecord& point : out.new_points) new_point_ids.insert(point.id);
+    out.keyframe = decodeKeyFrame(in.keyframe(), &new_point_ids);
     out.map_reset = in.map_reset();
     if (!(in.segmenter_nms() >= 0.f && in.segmenter_nms() <= 1.f)) {
       throw WireError(fmt::format("segmenter NMS threshold {} outside [0, 1]", in.segmenter_nms()));
     }
     out.segmenter_nms = in.segmenter_nms();
-    out.new_points = within("new points", [&] { return fromProto(in.new_points()); });
     const std::string& encoding = in.image_encoding();
     if (encoding.empty() != in.image().empty() ||
         !(encoding.empty() || encoding == "jpeg" || encoding == "png")) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <unordered_set>
 
 #include "features/scale_levels.h"
 #include "net/wire_convert.h"
@@ -142,8 +143,12 @@ void encodeDepth(const KeyFrameFeaturesRecord& features, v1::KeyFrameFeatures* o
   }
 }
 
+// `omit`: per keypoint, whether its descriptor stays home (empty: none does). A row the record
+// lacks (decoded with its descriptor left out) must be one of those: the wire never carries the
+// zero placeholder as if it were a descriptor.
 void encodeFeatures(const KeyFrameFeaturesRecord& features, KeyFrameId id,
-                    v1::KeyFrameFeatures* out, const WireEncodeOptions& options) {
+                    v1::KeyFrameFeatures* out, const WireEncodeOptions& options,
+                    const std::vector<bool>& omit) {
   const std::size_t n = features.keypoints.size();
   const cv::Mat& desc = features.descriptors;
   if (n > 0 &&
@@ -161,12 +166,24 @@ void encodeFeatures(const KeyFrameFeaturesRecord& features, KeyFrameId id,
     throw WireError(fmt::format("keyframe {:#x}: {} right_u values for {} keypoints", id,
                                 features.right_u.size(), n));
   }
+  const std::vector<bool>& missing = features.descriptor_omitted;
+  if (!missing.empty() && missing.size() != n) {
+    throw WireError(fmt::format("keyframe {:#x}: descriptor_omitted has {} flags for {} keypoints",
+                                id, missing.size(), n));
+  }
   encodeKeyPoints(features, id, out->mutable_keypoints(), options);
   std::string* bytes = out->mutable_descriptors();
-  bytes->resize(n * wire_limits::kDescriptorBytes);
+  bytes->reserve(n * wire_limits::kDescriptorBytes);
   for (std::size_t row = 0; row < n; ++row) {
-    std::memcpy(bytes->data() + row * wire_limits::kDescriptorBytes,
-                desc.ptr<std::uint8_t>(static_cast<int>(row)), wire_limits::kDescriptorBytes);
+    const bool omitted = !omit.empty() && omit[row];
+    if (omitted) continue;
+    if (!missing.empty() && missing[row]) {
+      throw WireError(fmt::format(
+          "keyframe {:#x}: keypoint {} has no descriptor (left out on its way in) to send", id,
+          row));
+    }
+    bytes->append(reinterpret_cast<const char*>(desc.ptr<std::uint8_t>(static_cast<int>(row))),
+                  wire_limits::kDescriptorBytes);
   }
   encodeDepth(features, out);
   if (rightUFollowsDepth(features)) {
@@ -223,18 +240,39 @@ void toProto(const SE3d& pose, v1::Pose* out) {
   out->set_tz(t.z());
 }
 
-void toProto(const KeyFrameRecord& keyframe, v1::KeyFrame* out, const WireEncodeOptions& options) {
+namespace {
+
+// The keypoints whose descriptor an upload leaves out: those associated with a point that is not
+// one of the upload's new points (the edge has it). Empty when there is none.
+std::vector<bool> knownPointKeypoints(const KeyFrameUpload& upload) {
+  std::unordered_set<MapPointId> new_ids;
+  new_ids.reserve(upload.new_points.size());
+  for (const MapPointRecord& point : upload.new_points) new_ids.insert(point.id);
+  const std::vector<MapPointId>& point_ids = upload.keyframe.point_ids;
+  std::vector<bool> known(point_ids.size(), false);
+  bool any = false;
+  for (std::size_t i = 0; i < point_ids.size(); ++i) {
+    known[i] = point_ids[i] != kInvalidId && !new_ids.contains(point_ids[i]);
+    any = any || known[i];
+  }
+  if (!any) known.clear();
+  return known;
+}
+
+void encodeKeyFrame(const KeyFrameRecord& keyframe, v1::KeyFrame* out,
+                    const WireEncodeOptions& options, const std::vector<bool>& omit) {
   out->set_id(keyframe.id);
   out->set_frame_index(keyframe.frame_index);
   out->set_timestamp(keyframe.timestamp);
   toProto(keyframe.T_cw, out->mutable_t_cw());
   out->set_parent(keyframe.parent);
-  encodeFeatures(keyframe.features, keyframe.id, out->mutable_features(), options);
   if (!keyframe.point_ids.empty() &&
       keyframe.point_ids.size() != keyframe.features.keypoints.size()) {
     throw WireError(fmt::format("keyframe {:#x}: {} point ids for {} keypoints", keyframe.id,
                                 keyframe.point_ids.size(), keyframe.features.keypoints.size()));
   }
+  encodeFeatures(keyframe.features, keyframe.id, out->mutable_features(), options, omit);
+  out->set_known_point_descriptors_omitted(!omit.empty());
   std::size_t next_index = 0;
   std::uint64_t previous_id = keyframe.id;
   for (std::size_t i = 0; i < keyframe.point_ids.size(); ++i) {
@@ -244,6 +282,12 @@ void toProto(const KeyFrameRecord& keyframe, v1::KeyFrame* out, const WireEncode
     next_index = i + 1;
     previous_id = keyframe.point_ids[i];
   }
+}
+
+}  // namespace
+
+void toProto(const KeyFrameRecord& keyframe, v1::KeyFrame* out, const WireEncodeOptions& options) {
+  encodeKeyFrame(keyframe, out, options, {});
 }
 
 void toProto(const std::vector<MapPointRecord>& points, v1::MapPoints* out, bool with_appearance) {
@@ -328,7 +372,9 @@ void toProto(const std::vector<KeyFramePoseRecord>& poses, v1::KeyFramePoses* ou
 void toProto(const KeyFrameUpload& upload, v1::KeyFrameUpload* out,
              const WireEncodeOptions& options) {
   out->set_sequence(upload.sequence);
-  toProto(upload.keyframe, out->mutable_keyframe(), options);
+  encodeKeyFrame(
+      upload.keyframe, out->mutable_keyframe(), options,
+      options.omit_known_point_descriptors ? knownPointKeypoints(upload) : std::vector<bool>{});
   if (!upload.new_points.empty()) {
     toProto(upload.new_points, out->mutable_new_points(), options.upload_point_appearance);
   }

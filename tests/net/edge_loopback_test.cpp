@@ -117,13 +117,14 @@ TEST_F(EdgeLoopback, UploadsReachTheBackendInOrderAndSlicesStreamBack) {
   const EdgeClientCounters counters = client.counters();
   EXPECT_EQ(counters.uploads_sent, kUploads + 1u);
   EXPECT_EQ(counters.uploads_dropped, 0u);
-  EXPECT_GT(counters.uplink_bytes, kUploads * 300u * 32u);
+  // Half the keypoints name points the edge has: only the other half's descriptors travel.
+  EXPECT_GT(counters.uplink_bytes, kUploads * 150u * 32u);
   EXPECT_GT(counters.downlink_bytes, kUploads * 20u * 60u);
   const std::vector<SessionStats> stats = server->sessions();
   ASSERT_EQ(stats.size(), 1u);
   EXPECT_EQ(stats[0].keyframes, kUploads + 1u);
   EXPECT_GE(stats[0].slices_acknowledged, static_cast<std::uint64_t>(kUploads));
-  EXPECT_GT(stats[0].uplink_bytes, kUploads * 300u * 32u);
+  EXPECT_GT(stats[0].uplink_bytes, kUploads * 150u * 32u);
   EXPECT_GT(stats[0].downlink_bytes, kUploads * 20u * 60u);
 }
 
