@@ -1,10 +1,44 @@
 #include "client/slice_applier.h"
 
+#include <optional>
+#include <unordered_set>
+#include <utility>
 #include <vector>
 
+#include "map/ids.h"
 #include "map/map_replication.h"
 
 namespace edgeslam {
+namespace {
+
+// The client goes on tracking and making keyframes (and, monocular, points) while the edge
+// optimises: those made after the slice's keyframe were placed against the map as it was, so when
+// the slice moves that keyframe they follow it rigidly, keeping their relation to the map they
+// were tracked in (as a loop correction carries the keyframes beyond the loop).
+std::size_t carryNewerKeyFrames(Map& map, const MapSlice& slice, const SE3d& anchor_before,
+                                const SE3d& anchor_after,
+                                const std::unordered_set<MapPointId>& points_in_slice) {
+  const KeyFrameId anchor = slice.processed_keyframe;
+  const SE3d world_correction = anchor_after.inverse() * anchor_before;  // old world -> new world
+  const SE3d pose_correction = anchor_before.inverse() * anchor_after;   // T_cw' = T_cw * this
+  std::unordered_set<MapPointId> carried_points;
+  std::size_t carried = 0;
+  for (KeyFrame* kf : map.keyFrames()) {
+    if (idOrigin(kf->id()) != idOrigin(anchor) || kf->id() <= anchor || kf->isBad()) continue;
+    map.setKeyFramePose(kf, kf->pose() * pose_correction);
+    ++carried;
+    for (MapPoint* p : kf->points()) {
+      if (p == nullptr || p->isBad() || points_in_slice.contains(p->id())) continue;
+      const KeyFrameId born = p->firstKeyFrameId();
+      if (born == kInvalidId || idOrigin(born) != idOrigin(anchor) || born <= anchor) continue;
+      if (!carried_points.insert(p->id()).second) continue;
+      map.relocatePoint(p, world_correction * p->position());
+    }
+  }
+  return carried;
+}
+
+}  // namespace
 
 SliceApplyResult applySlice(Map& map, const MapSlice& slice, const PinholeCamera& camera) {
   SliceApplyResult result;
@@ -39,8 +73,10 @@ SliceApplyResult applySlice(Map& map, const MapSlice& slice, const PinholeCamera
       if (kf->isBad()) ++result.keyframes_erased;
     }
   }
+  std::optional<std::pair<SE3d, SE3d>> anchor_move;  // the processed keyframe's before, after
   for (const KeyFramePoseRecord& record : slice.keyframe_poses) {
     if (KeyFrame* kf = map.keyFrame(record.id)) {
+      if (record.id == slice.processed_keyframe) anchor_move.emplace(kf->pose(), record.T_cw);
       map.setKeyFramePose(kf, record.T_cw);
       ++result.keyframes_moved;
     }
@@ -74,6 +110,15 @@ SliceApplyResult applySlice(Map& map, const MapSlice& slice, const PinholeCamera
       map.relocatePoint(p, record.position);
       ++result.points_moved;
     }
+  }
+  if (anchor_move && slice.processed_keyframe != kInvalidId) {
+    std::unordered_set<MapPointId> points_in_slice;
+    for (const MapPointRecord& record : slice.points_upserted) points_in_slice.insert(record.id);
+    for (const PointPositionRecord& record : slice.point_positions) {
+      points_in_slice.insert(record.id);
+    }
+    result.keyframes_carried =
+        carryNewerKeyFrames(map, slice, anchor_move->first, anchor_move->second, points_in_slice);
   }
   for (KeyFrame* kf : touched) {
     if (kf != nullptr && !kf->isBad() && !kf->isEvicted()) map.updateConnections(kf);

@@ -4,7 +4,9 @@
 // poses take the edge's optimised values. With a bounded client map, the keyframes the edge
 // evicts keep only their poses (their observations go, and the points no held keyframe sees),
 // and keyframes back in the window get their features and points again; records naming what the
-// client does not hold are ignored. Takes the map's update mutex for the duration.
+// client does not hold are ignored. Keyframes the client made after the slice's keyframe, and the
+// points they made, follow that keyframe's correction rigidly. Takes the map's update mutex for the
+// duration.
 #include <cstddef>
 #include <vector>
 
@@ -20,6 +22,8 @@ struct SliceApplyResult {
   std::size_t points_erased = 0;
   std::size_t keyframes_moved = 0;
   std::size_t keyframes_erased = 0;
+  // Keyframes newer than the slice's that followed its keyframe's correction.
+  std::size_t keyframes_carried = 0;
   std::size_t frame_index = 0;  // of the processed keyframe, 0 when the client does not have it
   std::vector<KeyFrameId> keyframes_evicted;  // held before, evicted now
   std::vector<KeyFrameId> keyframes_entered;  // held now, not (or evicted) before

@@ -1,0 +1,69 @@
+// Keyframes and points the client made after the slice's keyframe follow that keyframe's
+// correction: they were tracked against the map as it was, and must stay consistent with it.
+#include <gtest/gtest.h>
+
+#include "client/slice_applier.h"
+#include "map/map_replication.h"
+#include "map/synthetic_views.h"
+
+namespace edgeslam {
+namespace {
+
+TEST(SliceCarry, NewerClientKeyFramesAndTheirPointsFollowTheProcessedKeyFrame) {
+  test::SyntheticScene scene(150, 5);
+  Map client(1);
+  KeyFrame* processed =
+      scene.addKeyFrame(client, scene.view(test::poseAt({0, 0, 0}), 0, false), 0, true);
+  KeyFrame* newer =
+      scene.addKeyFrame(client, scene.view(test::poseAt({0.2, 0, 0}), 0, false), 3, false);
+  // The client triangulated a point in the newer keyframe; the edge has not heard of it.
+  MapPoint* own_point = client.createMapPoint({0.3, 0.1, 3.0}, newer);
+  client.addObservation(own_point, newer, 0);
+  MapPoint* edge_point = processed->point(1);
+  ASSERT_NE(edge_point, nullptr);
+
+  const SE3d before = processed->pose();
+  const SE3d after = SE3d(Eigen::AngleAxisd(0.02, Eigen::Vector3d::UnitY()).toRotationMatrix(),
+                          Eigen::Vector3d(0.05, -0.01, 0.02)) *
+                     before;
+  const SE3d newer_before = newer->pose();
+  const Eigen::Vector3d own_before = own_point->position();
+  const Eigen::Vector3d edge_point_before = edge_point->position();
+
+  MapSlice slice;
+  slice.sequence = 1;
+  slice.processed_keyframe = processed->id();
+  slice.newest_keyframe = processed->id();
+  slice.keyframe_poses.push_back({processed->id(), after, kInvalidId});
+  const SliceApplyResult applied = applySlice(client, slice, scene.camera());
+
+  EXPECT_EQ(applied.keyframes_carried, 1u);
+  // The newer keyframe keeps its pose relative to the processed one.
+  const SE3d relative_before = newer_before * before.inverse();
+  const SE3d relative_after = newer->pose() * processed->pose().inverse();
+  EXPECT_LT((relative_before.translation() - relative_after.translation()).norm(), 1e-9);
+  EXPECT_LT(relative_before.rotation().angularDistance(relative_after.rotation()), 1e-9);
+  // Its own point keeps its place in the processed keyframe's camera frame.
+  EXPECT_LT(((after * own_point->position()) - (before * own_before)).norm(), 1e-9);
+  // A point the edge knows is the edge's to move: untouched without a record.
+  EXPECT_LT((edge_point->position() - edge_point_before).norm(), 1e-12);
+}
+
+TEST(SliceCarry, NothingIsCarriedWhenTheProcessedKeyFrameDidNotMove) {
+  test::SyntheticScene scene(80, 6);
+  Map client(1);
+  KeyFrame* processed =
+      scene.addKeyFrame(client, scene.view(test::poseAt({0, 0, 0}), 0, false), 0, true);
+  KeyFrame* newer =
+      scene.addKeyFrame(client, scene.view(test::poseAt({0.2, 0, 0}), 0, false), 3, false);
+  const SE3d newer_before = newer->pose();
+  MapSlice slice;
+  slice.sequence = 1;
+  slice.processed_keyframe = processed->id();
+  const SliceApplyResult applied = applySlice(client, slice, scene.camera());
+  EXPECT_EQ(applied.keyframes_carried, 0u);
+  EXPECT_LT((newer->pose().translation() - newer_before.translation()).norm(), 1e-12);
+}
+
+}  // namespace
+}  // namespace edgeslam
