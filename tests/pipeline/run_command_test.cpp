@@ -30,7 +30,7 @@ TEST(RunCommand, WritesTheContractOutputs) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("Summary"), std::string::npos);
   for (const char* file :
-       {"trajectory.tum", "trajectory_final.tum", "keyframes.tum", "metrics.json"}) {
+       {"trajectory.tum", "trajectory_final.tum", "keyframes.tum", "metrics.json", "frames.csv"}) {
     EXPECT_TRUE(std::filesystem::exists(out / file)) << file;
   }
   EXPECT_EQ(readTumTrajectory(out / "trajectory.tum").size(), 40u);
@@ -49,6 +49,19 @@ TEST(RunCommand, WritesTheContractOutputs) {
   for (const char* stat : {"median", "p90", "p99", "max"}) {
     EXPECT_GT(metrics["client_ms"][stat].get<double>(), 0.0) << stat;
   }
+  // One row per frame after the header, each with its state and times.
+  std::ifstream frames(out / "frames.csv");
+  std::string line;
+  ASSERT_TRUE(std::getline(frames, line));
+  EXPECT_EQ(line.rfind("frame,timestamp,state,keyframe", 0), 0u) << line;
+  std::size_t rows = 0, keyframes = 0;
+  while (std::getline(frames, line)) {
+    ++rows;
+    EXPECT_NE(line.find(",ok,"), std::string::npos) << line;
+    if (line.find(",ok,1,") != std::string::npos) ++keyframes;
+  }
+  EXPECT_EQ(rows, 40u);
+  EXPECT_GE(keyframes, 1u);
 }
 
 TEST(RunCommand, MissingDatasetIsAClearError) {

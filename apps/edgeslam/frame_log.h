@@ -1,0 +1,28 @@
+#pragma once
+// Per-frame record of a run, written next to metrics.json as frames.csv: where the time went
+// frame by frame (a stall and the backlog it leaves show up here, not in the percentiles).
+#include <cstddef>
+#include <filesystem>
+#include <vector>
+
+#include "client/tracking_types.h"
+
+namespace edgeslam::cli {
+
+struct FrameLogEntry {
+  std::size_t index = 0;
+  double timestamp = 0.0;
+  TrackingState state = TrackingState::kNotInitialized;
+  bool keyframe = false;
+  bool relocalized = false;
+  int tracked_points = 0;
+  double load_ms = 0.0;
+  double client_ms = 0.0;
+  double e2e_ms = 0.0;
+};
+
+// Columns: frame,timestamp,state,keyframe,relocalized,tracked_points,load_ms,client_ms,e2e_ms.
+// Throws std::runtime_error naming the file when it cannot be written.
+void writeFrameLog(const std::filesystem::path& path, const std::vector<FrameLogEntry>& entries);
+
+}  // namespace edgeslam::cli
