@@ -1,13 +1,16 @@
 #pragma once
 // The client's keyframe sink in edge mode: turns each new keyframe (and the points the client made
-// with it) into an upload, and learns from the slices which keyframes the edge has mapped.
+// with it) into an upload, learns from the slices which keyframes the edge has mapped, and forgets
+// the keyframes whose upload the link dropped.
 #include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <deque>
 #include <mutex>
 #include <optional>
+#include <set>
 #include <unordered_set>
+#include <vector>
 
 #include "client/keyframe_uplink.h"
 #include "geometry/camera.h"
@@ -48,12 +51,34 @@ class EdgeKeyFrameSink : public KeyFrameSink {
   // was sent (negative when unknown), for the slice-latency statistics.
   double onSliceApplied(std::uint64_t upload_sequence, std::size_t processed_frame_index);
 
+  // The link gave up on upload `upload_sequence`, which carried `keyframe`: the edge will never
+  // map them, so no slice would ever evict, correct or cull the keyframe nor the points that went
+  // up with it. Under the map's update mutex the client forgets them: those points are erased,
+  // points the edge knows only lose this keyframe's observation, and the keyframe is erased (the
+  // map's origin, which cannot be erased, keeps only its pose). The upload no longer counts as in
+  // flight. Returns whether a keyframe was forgotten (false when the map no longer has it).
+  // Any thread; not under the map's update mutex.
+  bool onUploadDropped(std::uint64_t upload_sequence, KeyFrameId keyframe);
+
   std::uint64_t uploadsSent() const { return sequence_.load(); }
   std::uint64_t uploadsAnswered() const { return answered_.load(); }
-  bool allAnswered() const { return answered_.load() >= sequence_.load(); }
+  // Uploads that may still be answered by a slice (sent, not answered, not dropped).
+  std::uint64_t uploadsInFlight() const;
+  bool allAnswered() const { return uploadsInFlight() == 0; }
+  std::uint64_t keyFramesForgotten() const { return keyframes_forgotten_.load(); }
+  std::uint64_t pointsForgotten() const { return points_forgotten_.load(); }
 
  private:
   using Clock = std::chrono::steady_clock;
+  // What an upload carried that the edge learns from it alone.
+  struct UploadRecord {
+    std::uint64_t sequence = 0;
+    KeyFrameId keyframe = kInvalidId;
+    std::vector<MapPointId> new_points;
+    bool map_reset = false;
+  };
+  // Uploads remembered for onUploadDropped: well beyond the link's queue and those in flight.
+  static constexpr std::size_t kRememberedUploads = 64;
 
   Map& map_;
   KeyFrameUplink& uplink_;
@@ -66,8 +91,12 @@ class EdgeKeyFrameSink : public KeyFrameSink {
   std::size_t image_frame_ = 0;
   cv::Mat image_;
   std::unordered_set<MapPointId> uploaded_points_;
-  std::mutex sent_mutex_;
+  std::deque<UploadRecord> recent_uploads_;  // guarded by the map's update mutex
+  mutable std::mutex sent_mutex_;
   std::deque<std::pair<std::uint64_t, Clock::time_point>> sent_times_;
+  std::set<std::uint64_t> dropped_unanswered_;  // dropped sequences above answered_
+  std::atomic<std::uint64_t> keyframes_forgotten_{0};
+  std::atomic<std::uint64_t> points_forgotten_{0};
 };
 
 }  // namespace edgeslam

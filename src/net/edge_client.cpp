@@ -131,6 +131,27 @@ struct EdgeClient::Impl {
     return true;
   }
 
+  // Which upload was given up on, for the owner's callback.
+  struct DroppedUpload {
+    std::uint64_t sequence = 0;
+    KeyFrameId keyframe = kInvalidId;
+  };
+
+  static DroppedUpload identify(const KeyFrameUpload& upload) {
+    return {upload.sequence, upload.keyframe.id};
+  }
+
+  // Outside the client's mutex: the owner may take its own locks (its map's) here.
+  void reportDropped(const DroppedUpload& dropped) {
+    if (!options.on_upload_dropped) return;
+    try {
+      options.on_upload_dropped(dropped.sequence, dropped.keyframe);
+    } catch (const std::exception& e) {
+      spdlog::error("edge client: upload-dropped callback threw for upload {}: {}",
+                    dropped.sequence, e.what());
+    }
+  }
+
   void notify(const EdgeSessionEvent& event) {
     if (!options.on_session_event) return;
     try {
@@ -184,20 +205,31 @@ struct EdgeClient::Impl {
   // --- uploads ---------------------------------------------------------------------------------
 
   std::uint64_t enqueue(KeyFrameUpload upload) {
-    std::lock_guard lock(mutex);
-    if (upload.sequence == 0) upload.sequence = last_upload_sequence + 1;
-    last_upload_sequence = std::max(last_upload_sequence, upload.sequence);
-    const std::uint64_t sequence = upload.sequence;
-    if (closed) {
-      ++uploads_dropped;
-      return sequence;
+    std::optional<DroppedUpload> overflowed;
+    std::uint64_t sequence = 0;
+    {
+      std::lock_guard lock(mutex);
+      if (upload.sequence == 0) upload.sequence = last_upload_sequence + 1;
+      last_upload_sequence = std::max(last_upload_sequence, upload.sequence);
+      sequence = upload.sequence;
+      if (closed) {
+        ++uploads_dropped;
+        return sequence;
+      }
+      if (queue.size() >= options.upload_queue_capacity) {
+        overflowed = identify(queue.front());
+        queue.pop_front();
+        ++uploads_dropped;
+        ++uploads_overflowed;
+      }
+      queue.push_back(std::move(upload));
     }
-    if (queue.size() >= options.upload_queue_capacity) {
-      queue.pop_front();
-      ++uploads_dropped;
-    }
-    queue.push_back(std::move(upload));
     wake.notify_all();
+    if (overflowed) {
+      spdlog::debug("edge client: upload {} (keyframe {:#x}) pushed out of the full queue",
+                    overflowed->sequence, overflowed->keyframe);
+      reportDropped(*overflowed);
+    }
     return sequence;
   }
 
@@ -205,6 +237,7 @@ struct EdgeClient::Impl {
     Backoff backoff(options.backoff_initial, options.backoff_max);
     while (true) {
       KeyFrameUpload upload;
+      DroppedUpload which;
       {
         std::unique_lock lock(mutex);
         wake.wait(lock, [&] { return stopping || !queue.empty(); });
@@ -212,6 +245,7 @@ struct EdgeClient::Impl {
         upload = std::move(queue.front());
         queue.pop_front();
         in_flight = true;
+        which = identify(upload);
       }
       v1::UploadKeyFrameRequest request;
       try {
@@ -231,23 +265,36 @@ struct EdgeClient::Impl {
         }
       } catch (const std::exception& e) {
         spdlog::error("edge client: upload {} cannot be encoded: {}", upload.sequence, e.what());
-        finishUpload(false, true);
+        finishUpload(Outcome::kRejected, which);
         continue;
       }
-      sendWithRetry(request, backoff);
+      sendWithRetry(request, which, backoff);
     }
   }
 
-  void finishUpload(bool sent, bool rejected) {
+  enum class Outcome {
+    kSent,
+    kRejected,   // refused by the server or not encodable: reported to the owner
+    kDiscarded,  // the client is closing
+  };
+
+  void finishUpload(Outcome outcome, const DroppedUpload& which) {
+    // Reported before the upload counts as done, so that flushUploads() returning means the
+    // owner has heard of it.
+    if (outcome == Outcome::kRejected) reportDropped(which);
     std::lock_guard lock(mutex);
     in_flight = false;
-    if (sent) ++uploads_sent;
-    if (!sent) ++uploads_dropped;
-    if (rejected) ++uploads_rejected;
+    if (outcome == Outcome::kSent) {
+      ++uploads_sent;
+    } else {
+      ++uploads_dropped;
+    }
+    if (outcome == Outcome::kRejected) ++uploads_rejected;
     flushed.notify_all();
   }
 
-  void sendWithRetry(v1::UploadKeyFrameRequest& request, Backoff& backoff) {
+  void sendWithRetry(v1::UploadKeyFrameRequest& request, const DroppedUpload& which,
+                     Backoff& backoff) {
     while (true) {
       const std::uint64_t session = session_id.load();
       *request.mutable_header() = header();
@@ -257,7 +304,7 @@ struct EdgeClient::Impl {
       context.set_deadline(deadlineIn(options.rpc_timeout));
       {
         std::lock_guard lock(mutex);
-        if (stopping) return finishUpload(false, false);
+        if (stopping) return finishUpload(Outcome::kDiscarded, which);
         upload_context = &context;
       }
       v1::UploadKeyFrameReply reply;
@@ -270,18 +317,20 @@ struct EdgeClient::Impl {
         uplink += request.ByteSizeLong();
         downlink += reply.ByteSizeLong();
         backoff.reset();
-        return finishUpload(true, false);
+        return finishUpload(Outcome::kSent, which);
       }
-      if (isStopping()) return finishUpload(false, false);
+      if (isStopping()) return finishUpload(Outcome::kDiscarded, which);
       if (status.error_code() == grpc::StatusCode::NOT_FOUND) {
         if (reopenSession(session, "keyframe upload: " + status.error_message())) continue;
       } else if (isPermanent(status.error_code())) {
         spdlog::error("edge client: upload {} rejected: {}", request.upload().sequence(),
                       describe(status));
-        return finishUpload(false, true);
+        return finishUpload(Outcome::kRejected, which);
       }
+      // Anything else (unreachable, deadline exceeded: perhaps after the server had it) is
+      // retried; the server passes a retried sequence on once only.
       ++upload_retries;
-      if (sleepUnlessStopping(backoff.next())) return finishUpload(false, false);
+      if (sleepUnlessStopping(backoff.next())) return finishUpload(Outcome::kDiscarded, which);
     }
   }
 
@@ -390,6 +439,7 @@ struct EdgeClient::Impl {
   grpc::ClientContext* stream_context = nullptr;
   std::uint64_t uploads_sent = 0;
   std::uint64_t uploads_dropped = 0;
+  std::uint64_t uploads_overflowed = 0;
   std::uint64_t uploads_rejected = 0;
 
   std::atomic<std::uint64_t> uplink{0};
@@ -514,6 +564,7 @@ EdgeClientCounters EdgeClient::counters() const {
     std::lock_guard lock(impl_->mutex);
     c.uploads_sent = impl_->uploads_sent;
     c.uploads_dropped = impl_->uploads_dropped;
+    c.uploads_overflowed = impl_->uploads_overflowed;
     c.uploads_rejected = impl_->uploads_rejected;
   }
   c.upload_retries = impl_->upload_retries.load();

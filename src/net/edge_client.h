@@ -53,14 +53,23 @@ struct EdgeClientOptions {
   // client that does not stream slices (probing, offload mode).
   std::function<void(MapSlice)> on_slice;
   std::function<void(const EdgeSessionEvent&)> on_session_event;
+  // Called once for every upload the client gives up on while the session runs: pushed out of
+  // the full queue (on the thread calling uploadKeyFrame), refused by the server or not encodable
+  // (on the upload thread, before the next upload is sent and before flushUploads sees it done).
+  // Never under the client's own lock. Not called for uploads close() discards: the session is
+  // over. An upload whose deadline passed after its bytes went out is not dropped but retried;
+  // the server passes a retry of an upload it already has on once only.
+  std::function<void(std::uint64_t sequence, KeyFrameId keyframe)> on_upload_dropped;
 };
 
 struct EdgeClientCounters {
   std::uint64_t uplink_bytes = 0;    // serialized bytes of requests the server received
   std::uint64_t downlink_bytes = 0;  // serialized bytes of replies and slices received
   std::uint64_t uploads_sent = 0;
-  std::uint64_t uploads_dropped = 0;   // pushed out of the full queue, or rejected by the server
-  std::uint64_t uploads_rejected = 0;  // of those, refused by the server (malformed, too big)
+  // Pushed out of the full queue, rejected by the server, not encodable, or discarded by close().
+  std::uint64_t uploads_dropped = 0;
+  std::uint64_t uploads_overflowed = 0;  // of those, pushed out of the full queue
+  std::uint64_t uploads_rejected = 0;    // of those, refused by the server (malformed, too big)
   std::uint64_t upload_retries = 0;
   std::uint64_t slices_received = 0;
   std::uint64_t reconnects = 0;  // slice streams re-established after a failure

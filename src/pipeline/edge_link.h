@@ -5,6 +5,7 @@
 #include <functional>
 
 #include "client/keyframe_uplink.h"
+#include "map/ids.h"
 #include "map/map_records.h"
 
 namespace edgeslam {
@@ -15,17 +16,24 @@ struct EdgeLinkCounters {
   std::uint64_t uplink_bytes = 0;
   std::uint64_t downlink_bytes = 0;
   std::uint64_t uploads_dropped = 0;
+  std::uint64_t uploads_overflowed = 0;  // of those, pushed out of a full upload queue
   std::uint64_t reconnects = 0;
 };
 
 class EdgeLink : public KeyFrameUplink {
  public:
   using SliceHandler = std::function<void(MapSlice)>;
+  // An upload the link gave up on for good while the session runs (its sequence, the keyframe it
+  // carried): the edge will never see it. Called on the link's thread or on the sender's (an
+  // upload pushed out of a full queue), never under the link's own locks.
+  using UploadDroppedHandler = std::function<void(std::uint64_t sequence, KeyFrameId keyframe)>;
 
   // The id origin byte the session gave this client (its map element ids start with it).
   virtual std::uint8_t idOrigin() const = 0;
   // Called on the link's own thread for every slice; set before the first upload.
   virtual void setSliceHandler(SliceHandler handler) = 0;
+  // Set before the first upload. The default suits a link that never drops an upload.
+  virtual void setUploadDroppedHandler(UploadDroppedHandler /*handler*/) {}
   virtual EdgeLinkCounters counters() const = 0;
   virtual void close() = 0;
   // The gRPC client under this link, for probing; nullptr when there is no network.

@@ -18,6 +18,8 @@ EdgeSlam::EdgeSlam(const PinholeCamera& camera, SlamOptions options, std::unique
   sink_options.camera = camera_;
   sink_ = std::make_unique<EdgeKeyFrameSink>(map_, *link_, sink_options);
   link_->setSliceHandler([this](MapSlice slice) { onSlice(std::move(slice)); });
+  link_->setUploadDroppedHandler(
+      [this](std::uint64_t sequence, KeyFrameId keyframe) { onUploadDropped(sequence, keyframe); });
   options_.tracker.triangulate_at_keyframes = options_.client_triangulation;
   startTracking(sink_.get());
   if (adaptation && link_->edgeClient() != nullptr) {
@@ -88,7 +90,21 @@ std::size_t EdgeSlam::mapPointCount() const {
   return TrackingSlam::mapPointCount();
 }
 
+void EdgeSlam::onUploadDropped(std::uint64_t sequence, KeyFrameId keyframe) {
+  // May run on the tracking thread inside track() (an upload pushed out of the link's full
+  // queue): the tracker hears of it after the frame.
+  if (!sink_->onUploadDropped(sequence, keyframe)) return;
+  std::lock_guard lock(stats_mutex_);
+  forgotten_keyframes_.push_back(keyframe);
+}
+
 void EdgeSlam::afterFrame() {
+  std::vector<KeyFrameId> forgotten;
+  {
+    std::lock_guard lock(stats_mutex_);
+    forgotten.swap(forgotten_keyframes_);
+  }
+  if (!forgotten.empty()) tracker_->onMapWindowChanged(forgotten, {});
   {
     // Tracking adds keyframes and points between slices: the client map's peak is seen here.
     std::size_t keyframes = 0, points = 0;
@@ -203,6 +219,9 @@ SlamCounters EdgeSlam::counters() const {
   out.uplink_bytes = link.uplink_bytes;
   out.downlink_bytes = link.downlink_bytes;
   out.uploads_dropped = link.uploads_dropped;
+  out.uploads_overflowed = link.uploads_overflowed;
+  out.keyframes_forgotten = sink_->keyFramesForgotten();
+  out.points_forgotten = sink_->pointsForgotten();
   out.reconnects = link.reconnects;
   out.keyframes_uploaded = sink_->uploadsSent();
   std::lock_guard lock(stats_mutex_);

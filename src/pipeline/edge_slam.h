@@ -5,6 +5,7 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <vector>
 
 #include "client/edge_keyframe_sink.h"
 #include "pipeline/adaptation_loop.h"
@@ -31,7 +32,7 @@ class EdgeSlam : public TrackingSlam {
            std::optional<AdaptationLoopOptions> adaptation = std::nullopt);
   ~EdgeSlam() override;
 
-  // Waits (up to `timeout_s`) until every upload has been answered by a slice.
+  // Waits (up to `timeout_s`) until every upload has been answered by a slice (or dropped).
   void finish() override;
   SlamCounters counters() const override;
   // nullptr without adaptation.
@@ -49,6 +50,7 @@ class EdgeSlam : public TrackingSlam {
 
  private:
   void onSlice(MapSlice slice);
+  void onUploadDropped(std::uint64_t sequence, KeyFrameId keyframe);
   void offerMask(const MaskRecord& mask);
   void afterFrame() override;
   void beforeTracking(std::size_t frame_index, const cv::Mat& image) override;
@@ -70,6 +72,9 @@ class EdgeSlam : public TrackingSlam {
   std::uint64_t edge_map_keyframes_ = 0;  // as the last slice said (0 = not said)
   std::uint64_t edge_map_points_ = 0;
   ClientMapSize client_map_;
+  // Keyframes forgotten after their upload was dropped, for the tracker's relocalisation
+  // database (told on the tracking thread, between frames).
+  std::vector<KeyFrameId> forgotten_keyframes_;
 };
 
 }  // namespace edgeslam

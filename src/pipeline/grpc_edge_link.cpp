@@ -7,6 +7,9 @@ namespace edgeslam {
 GrpcEdgeLink::GrpcEdgeLink(const std::string& server_address, SessionConfig config,
                            EdgeClientOptions options) {
   options.on_slice = [this](MapSlice slice) { deliver(std::move(slice)); };
+  options.on_upload_dropped = [this](std::uint64_t sequence, KeyFrameId keyframe) {
+    reportDropped(sequence, keyframe);
+  };
   options.on_session_event = [](const EdgeSessionEvent& event) {
     if (event.reopened) spdlog::warn("edge session reopened: {}", event.reason);
     if (event.full_resync_needed) spdlog::warn("edge asks for a full resync: {}", event.reason);
@@ -32,9 +35,26 @@ void GrpcEdgeLink::deliver(MapSlice slice) {
   if (handler_) handler_(std::move(slice));
 }
 
+void GrpcEdgeLink::setUploadDroppedHandler(UploadDroppedHandler handler) {
+  std::lock_guard lock(dropped_mutex_);
+  dropped_handler_ = std::move(handler);
+}
+
+void GrpcEdgeLink::reportDropped(std::uint64_t sequence, KeyFrameId keyframe) {
+  // Serialises the reports (the sender's thread and the upload thread may both drop one).
+  std::lock_guard lock(dropped_mutex_);
+  if (dropped_handler_) dropped_handler_(sequence, keyframe);
+}
+
 EdgeLinkCounters GrpcEdgeLink::counters() const {
   const EdgeClientCounters c = client_->counters();
-  return {c.uplink_bytes, c.downlink_bytes, c.uploads_dropped, c.reconnects};
+  EdgeLinkCounters out;
+  out.uplink_bytes = c.uplink_bytes;
+  out.downlink_bytes = c.downlink_bytes;
+  out.uploads_dropped = c.uploads_dropped;
+  out.uploads_overflowed = c.uploads_overflowed;
+  out.reconnects = c.reconnects;
+  return out;
 }
 
 void GrpcEdgeLink::close() {

@@ -19,6 +19,7 @@ class GrpcEdgeLink : public EdgeLink {
   void send(KeyFrameUpload upload) override;
   std::uint8_t idOrigin() const override { return client_->idOrigin(); }
   void setSliceHandler(SliceHandler handler) override;
+  void setUploadDroppedHandler(UploadDroppedHandler handler) override;
   EdgeLinkCounters counters() const override;
   void close() override;
 
@@ -27,9 +28,12 @@ class GrpcEdgeLink : public EdgeLink {
 
  private:
   void deliver(MapSlice slice);
+  void reportDropped(std::uint64_t sequence, KeyFrameId keyframe);
 
   std::mutex handler_mutex_;
   SliceHandler handler_;
+  std::mutex dropped_mutex_;
+  UploadDroppedHandler dropped_handler_;
   std::unique_ptr<EdgeClient> client_;
 };
 

@@ -26,6 +26,18 @@ void InProcessEdgeLink::send(KeyFrameUpload upload) {
   cv_.notify_one();
 }
 
+void InProcessEdgeLink::setUploadDroppedHandler(UploadDroppedHandler handler) {
+  std::lock_guard lock(mutex_);
+  dropped_handler_ = std::move(handler);
+}
+
+EdgeLinkCounters InProcessEdgeLink::counters() const {
+  std::lock_guard lock(mutex_);
+  EdgeLinkCounters out;
+  out.uploads_dropped = uploads_dropped_;
+  return out;
+}
+
 void InProcessEdgeLink::run() {
   while (true) {
     KeyFrameUpload upload;
@@ -37,11 +49,22 @@ void InProcessEdgeLink::run() {
       queue_.pop_front();
       busy_ = true;
     }
+    bool rejected = false;
     try {
       compressKeyFrameImage(upload);
       session_->onKeyFrame(upload);
     } catch (const std::exception& e) {
       spdlog::error("edge session rejected keyframe upload {}: {}", upload.sequence, e.what());
+      rejected = true;
+    }
+    if (rejected) {
+      UploadDroppedHandler report;
+      {
+        std::lock_guard lock(mutex_);
+        ++uploads_dropped_;
+        report = dropped_handler_;
+      }
+      if (report) report(upload.sequence, upload.keyframe.id);
     }
     {
       std::lock_guard lock(mutex_);

@@ -21,7 +21,9 @@ class InProcessEdgeLink : public EdgeLink {
   void send(KeyFrameUpload upload) override;
   std::uint8_t idOrigin() const override { return 1; }
   void setSliceHandler(SliceHandler handler) override { handler_ = std::move(handler); }
-  EdgeLinkCounters counters() const override { return {}; }
+  // Called on the worker thread for an upload the session refused.
+  void setUploadDroppedHandler(UploadDroppedHandler handler) override;
+  EdgeLinkCounters counters() const override;
   void close() override;
   // Waits until every sent upload is mapped and its slice handed over.
   void flush();
@@ -32,7 +34,9 @@ class InProcessEdgeLink : public EdgeLink {
 
   std::unique_ptr<EdgeMapSession> session_;
   SliceHandler handler_;
-  std::mutex mutex_;
+  UploadDroppedHandler dropped_handler_;  // guarded by mutex_
+  std::uint64_t uploads_dropped_ = 0;     // guarded by mutex_
+  mutable std::mutex mutex_;
   std::condition_variable cv_;
   std::condition_variable drained_;
   bool busy_ = false;
