@@ -10,7 +10,8 @@
 //  (3) the frame has at least alpha times the reference keyframe's feature count (a good image);
 //  (4) the frame's tracked points are fewer than beta times the reference keyframe's tracked points
 //      (the view has changed).
-// A frame is a keyframe when (3) holds and either (1) and (4) hold, or (2) is violated.
+// A frame is a keyframe when (3) holds and either (1) and (4) hold, or (2) is violated and the
+// mapper can take an urgent keyframe (else a slow edge would get one keyframe per frame).
 // Guard (why: with fmin = 10-40 frames, fast motion would lose tracking before the next keyframe is
 // allowed): when the tracked ratio falls below `starving_ratio`, rule (1) is waived.
 // Segmentation refresh (semantic culling on): people who walk into view appear in the movable mask

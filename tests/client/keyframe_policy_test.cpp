@@ -44,6 +44,15 @@ TEST(KeyFramePolicy, Rule2ForcesAKeyFrameAfterFmax) {
   EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kYesForced);
 }
 
+TEST(KeyFramePolicy, AnOverdueMapUpdateForcesNothingPastTheUrgentBound) {
+  KeyFrameEvidence e = healthy();
+  e.frames_since_map_update = 60;  // the edge is seconds behind
+  e.mapper_accepts = false;
+  EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kYesForced);
+  e.mapper_accepts_urgent = false;  // and its urgent allowance is used up
+  EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kNo);
+}
+
 TEST(KeyFramePolicy, Rule3RejectsPoorImages) {
   KeyFrameEvidence e = healthy();
   e.frames_since_map_update = 100;
