@@ -9,13 +9,23 @@
 namespace edgeslam {
 namespace {
 
-TEST(SliceCarry, NewerClientKeyFramesAndTheirPointsFollowTheProcessedKeyFrame) {
-  test::SyntheticScene scene(150, 5);
-  Map client(1);
+// A client map with the keyframe a slice answers (with points) and a newer one the edge has not
+// processed yet.
+struct ClientWithNewerKeyFrame {
+  test::SyntheticScene scene{150, 5};
+  Map client{1};
   KeyFrame* processed =
       scene.addKeyFrame(client, scene.view(test::poseAt({0, 0, 0}), 0, false), 0, true);
   KeyFrame* newer =
       scene.addKeyFrame(client, scene.view(test::poseAt({0.2, 0, 0}), 0, false), 3, false);
+};
+
+TEST(SliceCarry, NewerClientKeyFramesAndTheirPointsFollowTheProcessedKeyFrame) {
+  ClientWithNewerKeyFrame t;
+  test::SyntheticScene& scene = t.scene;
+  Map& client = t.client;
+  KeyFrame* processed = t.processed;
+  KeyFrame* newer = t.newer;
   // The client triangulated a point in the newer keyframe; the edge has not heard of it.
   MapPoint* own_point = client.createMapPoint({0.3, 0.1, 3.0}, newer);
   client.addObservation(own_point, newer, 0);
@@ -50,17 +60,13 @@ TEST(SliceCarry, NewerClientKeyFramesAndTheirPointsFollowTheProcessedKeyFrame) {
 }
 
 TEST(SliceCarry, NothingIsCarriedWhenTheProcessedKeyFrameDidNotMove) {
-  test::SyntheticScene scene(80, 6);
-  Map client(1);
-  KeyFrame* processed =
-      scene.addKeyFrame(client, scene.view(test::poseAt({0, 0, 0}), 0, false), 0, true);
-  KeyFrame* newer =
-      scene.addKeyFrame(client, scene.view(test::poseAt({0.2, 0, 0}), 0, false), 3, false);
+  ClientWithNewerKeyFrame t;
+  KeyFrame* newer = t.newer;
   const SE3d newer_before = newer->pose();
   MapSlice slice;
   slice.sequence = 1;
-  slice.processed_keyframe = processed->id();
-  const SliceApplyResult applied = applySlice(client, slice, scene.camera());
+  slice.processed_keyframe = t.processed->id();
+  const SliceApplyResult applied = applySlice(t.client, slice, t.scene.camera());
   EXPECT_EQ(applied.keyframes_carried, 0u);
   EXPECT_LT((newer->pose().translation() - newer_before.translation()).norm(), 1e-12);
 }

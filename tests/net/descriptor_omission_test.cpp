@@ -12,10 +12,12 @@
 #include "net/wire_convert.h"
 #include "net_test_records.h"
 #include "record_expectations.h"
+#include "wire_decode_error.h"
 
 namespace edgeslam {
 namespace {
 
+using test::decodeError;
 using ::testing::HasSubstr;
 
 constexpr int kKeypoints = 100;
@@ -47,17 +49,6 @@ std::vector<bool> expectedOmitted(const KeyFrameUpload& upload) {
 
 std::size_t countOf(const std::vector<bool>& flags) {
   return static_cast<std::size_t>(std::count(flags.begin(), flags.end(), true));
-}
-
-template <typename Message>
-std::string decodeError(const Message& message) {
-  try {
-    (void)fromProto(message);
-  } catch (const WireError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "decoding succeeded";
-  return {};
 }
 
 TEST(DescriptorOmission, UploadShrinksBy32BytesPerKnownPointKeypoint) {

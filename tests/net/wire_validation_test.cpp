@@ -6,10 +6,12 @@
 
 #include "net/wire_convert.h"
 #include "net_test_records.h"
+#include "wire_decode_error.h"
 
 namespace edgeslam {
 namespace {
 
+using test::decodeError;
 using ::testing::HasSubstr;
 
 v1::KeyFrame validKeyFrame(int n = 10) {
@@ -17,17 +19,6 @@ v1::KeyFrame validKeyFrame(int n = 10) {
   v1::KeyFrame message;
   toProto(test::sampleKeyFrame(test::clientId(3, 9), n, rng), &message);
   return message;
-}
-
-template <typename Message>
-std::string decodeError(const Message& message) {
-  try {
-    (void)fromProto(message);
-  } catch (const WireError& e) {
-    return e.what();
-  }
-  ADD_FAILURE() << "decoding succeeded";
-  return {};
 }
 
 TEST(WireValidation, ValidKeyFrameDecodes) {
