@@ -17,14 +17,18 @@ namespace {
 // were tracked in (as a loop correction carries the keyframes beyond the loop).
 std::size_t carryNewerKeyFrames(Map& map, const MapSlice& slice, const SE3d& anchor_before,
                                 const SE3d& anchor_after,
-                                const std::unordered_set<MapPointId>& points_in_slice) {
+                                const std::unordered_set<MapPointId>& points_in_slice,
+                                const std::unordered_set<KeyFrameId>& keyframes_in_slice) {
   const KeyFrameId anchor = slice.processed_keyframe;
   const SE3d world_correction = anchor_after.inverse() * anchor_before;  // old world -> new world
   const SE3d pose_correction = anchor_before.inverse() * anchor_after;   // T_cw' = T_cw * this
   std::unordered_set<MapPointId> carried_points;
   std::size_t carried = 0;
   for (KeyFrame* kf : map.keyFrames()) {
-    if (idOrigin(kf->id()) != idOrigin(anchor) || kf->id() <= anchor || kf->isBad()) continue;
+    if (idOrigin(kf->id()) != idOrigin(anchor) || kf->id() <= anchor || kf->isBad() ||
+        keyframes_in_slice.contains(kf->id())) {
+      continue;  // the edge's own pose for it, when the slice has one, is the one to keep
+    }
     map.setKeyFramePose(kf, kf->pose() * pose_correction);
     ++carried;
     for (MapPoint* p : kf->points()) {
@@ -117,8 +121,13 @@ SliceApplyResult applySlice(Map& map, const MapSlice& slice, const PinholeCamera
     for (const PointPositionRecord& record : slice.point_positions) {
       points_in_slice.insert(record.id);
     }
-    result.keyframes_carried =
-        carryNewerKeyFrames(map, slice, anchor_move->first, anchor_move->second, points_in_slice);
+    std::unordered_set<KeyFrameId> keyframes_in_slice;
+    for (const KeyFramePoseRecord& record : slice.keyframe_poses) {
+      keyframes_in_slice.insert(record.id);
+    }
+    for (const KeyFrameRecord& record : slice.keyframes) keyframes_in_slice.insert(record.id);
+    result.keyframes_carried = carryNewerKeyFrames(
+        map, slice, anchor_move->first, anchor_move->second, points_in_slice, keyframes_in_slice);
   }
   for (KeyFrame* kf : touched) {
     if (kf != nullptr && !kf->isBad() && !kf->isEvicted()) map.updateConnections(kf);

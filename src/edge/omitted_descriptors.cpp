@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cstring>
+#include <random>
 #include <stdexcept>
 #include <string>
 
@@ -12,14 +13,10 @@ namespace {
 // Bits that no real descriptor nor another lost keypoint is close to (~128 bits from each): two
 // zero rows would match each other at distance 0 in triangulation and fusion.
 void fillWithNoise(std::uint8_t* row, std::uint64_t seed) {
+  std::mt19937_64 bits(seed);
   for (int word = 0; word < 4; ++word) {
-    // splitmix64
-    seed += 0x9e3779b97f4a7c15ULL;
-    std::uint64_t z = seed;
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    z ^= z >> 31;
-    std::memcpy(row + 8 * word, &z, 8);
+    const std::uint64_t value = bits();
+    std::memcpy(row + 8 * word, &value, 8);
   }
 }
 

@@ -144,8 +144,8 @@ void encodeDepth(const KeyFrameFeaturesRecord& features, v1::KeyFrameFeatures* o
 }
 
 // `omit`: per keypoint, whether its descriptor stays home (empty: none does). A row the record
-// lacks (decoded with its descriptor left out) must be one of those: the wire never carries the
-// zero placeholder as if it were a descriptor.
+// lacks (decoded from an upload that left it out, so all zeros until the edge fills it) must be
+// one of those: the wire never carries such a row as if it were a descriptor.
 void encodeFeatures(const KeyFrameFeaturesRecord& features, KeyFrameId id,
                     v1::KeyFrameFeatures* out, const WireEncodeOptions& options,
                     const std::vector<bool>& omit) {

@@ -59,6 +59,22 @@ TEST(SliceCarry, NewerClientKeyFramesAndTheirPointsFollowTheProcessedKeyFrame) {
   EXPECT_LT((edge_point->position() - edge_point_before).norm(), 1e-12);
 }
 
+TEST(SliceCarry, ANewerKeyFrameThatTheSliceMovesKeepsTheEdgesPose) {
+  ClientWithNewerKeyFrame t;
+  const SE3d processed_after =
+      SE3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0.03, 0, 0)) * t.processed->pose();
+  const SE3d newer_from_edge =
+      SE3d(Eigen::Quaterniond::Identity(), Eigen::Vector3d(0, 0.04, 0)) * t.newer->pose();
+  MapSlice slice;
+  slice.sequence = 1;
+  slice.processed_keyframe = t.processed->id();
+  slice.keyframe_poses.push_back({t.processed->id(), processed_after, kInvalidId});
+  slice.keyframe_poses.push_back({t.newer->id(), newer_from_edge, kInvalidId});
+  const SliceApplyResult applied = applySlice(t.client, slice, t.scene.camera());
+  EXPECT_EQ(applied.keyframes_carried, 0u);
+  EXPECT_LT((t.newer->pose().translation() - newer_from_edge.translation()).norm(), 1e-12);
+}
+
 TEST(SliceCarry, NothingIsCarriedWhenTheProcessedKeyFrameDidNotMove) {
   ClientWithNewerKeyFrame t;
   KeyFrame* newer = t.newer;

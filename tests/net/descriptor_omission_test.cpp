@@ -144,7 +144,8 @@ TEST(DescriptorOmission, DecodedUploadReencodesOnlyWithTheSameRowsLeftOut) {
   v1::KeyFrameUpload again;
   toProto(decoded, &again, omitting());
   EXPECT_EQ(again.keyframe().features().descriptors(), message.keyframe().features().descriptors());
-  // Sending all would put the zero placeholders on the wire as descriptors.
+  // Sending every row would put the left-out rows (zeros after decoding) on the wire as
+  // descriptors: refused.
   v1::KeyFrameUpload all;
   try {
     toProto(decoded, &all);
