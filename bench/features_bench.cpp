@@ -1,11 +1,13 @@
 // ORB extraction and matching timings on real frames, with OpenCV's ORB as the baseline in the
 // same run. Meant to be run pinned to one core (bench/run.sh does).
 #include <benchmark/benchmark.h>
+#include <fmt/format.h>
 
 #include <opencv2/features2d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
+#include <vector>
 
 #include "bench_support.h"
 #include "features/descriptor_matching.h"
@@ -21,7 +23,7 @@ const char* const kSevenScenesLater = "datasets/7scenes-redkitchen-1000/frame-00
 const char* const kKitti = "datasets/kitti07-160/image_0/000000.png";
 
 // Grey image, or empty with the benchmark marked skipped.
-cv::Mat loadGrey(benchmark::State& state, const char* relative) {
+cv::Mat loadGrey(benchmark::State& state, const std::string& relative) {
   const auto path = bench::sharedPath(relative);
   cv::Mat image = cv::imread(path.string(), cv::IMREAD_GRAYSCALE);
   if (image.empty()) state.SkipWithError(("cannot read " + path.string()).c_str());
@@ -62,6 +64,40 @@ void BM_OrbExtract_7Scenes(benchmark::State& state) {
 void BM_CvOrb_7Scenes(benchmark::State& state) {
   extractOpenCv(state, kSevenScenes);
 }
+// Every frame of KITTI 07-160 in turn: frame 0 alone is less textured than the drive's average.
+void extractSequence(benchmark::State& state, bool ours) {
+  std::vector<cv::Mat> images;
+  for (int i = 0; i < 160; i += 4) {
+    images.push_back(loadGrey(state, fmt::format("datasets/kitti07-160/image_0/{:06d}.png", i)));
+    if (images.back().empty()) return;
+  }
+  OrbExtractorOptions options;
+  options.num_features = static_cast<int>(state.range(0));
+  if (state.range(1) > 0) options.fast_threshold_min = static_cast<int>(state.range(1));
+  OrbExtractor extractor(options);
+  auto orb = cv::ORB::create(options.num_features);
+  std::vector<cv::KeyPoint> keypoints;
+  cv::Mat descriptors;
+  std::size_t next = 0;
+  for (auto _ : state) {
+    const cv::Mat& image = images[next++ % images.size()];
+    if (ours) {
+      extractor.extract(image, keypoints, descriptors);
+    } else {
+      orb->detectAndCompute(image, cv::noArray(), keypoints, descriptors);
+    }
+    benchmark::DoNotOptimize(descriptors.data);
+  }
+  state.counters["keypoints"] = static_cast<double>(keypoints.size());
+}
+
+void BM_OrbExtract_KittiSequence(benchmark::State& state) {
+  extractSequence(state, true);
+}
+void BM_CvOrb_KittiSequence(benchmark::State& state) {
+  extractSequence(state, false);
+}
+
 void BM_OrbExtract_Kitti(benchmark::State& state) {
   extractOurs(state, kKitti);
 }
@@ -153,6 +189,9 @@ BENCHMARK(BM_OrbExtract_7Scenes)->Arg(1000)->Apply(configure);
 BENCHMARK(BM_CvOrb_7Scenes)->Arg(1000)->Apply(configure);
 BENCHMARK(BM_OrbExtract_Kitti)->Arg(2000)->Apply(configure);
 BENCHMARK(BM_CvOrb_Kitti)->Arg(2000)->Apply(configure);
+// Second argument: the retry threshold (0: the default 7; 20: no retry in empty cells).
+BENCHMARK(BM_OrbExtract_KittiSequence)->Args({2000, 0})->Args({2000, 20})->Apply(configure);
+BENCHMARK(BM_CvOrb_KittiSequence)->Args({2000, 0})->Apply(configure);
 BENCHMARK(BM_Describe_SteeredBrief)->Apply(configure);
 BENCHMARK(BM_Describe_CvOrbCompute)->Apply(configure);
 BENCHMARK(BM_MatchInWindow_7Scenes)->Apply(configure);

@@ -435,6 +435,33 @@ def median_of(runs, *keys):
     return statistics.median(values) if values else None
 
 
+def range_of(runs, *keys):
+    """' [min-max]' of the runs' values when there are several, else ''."""
+    values = [v for v in (get(r, *keys) for r in runs) if isinstance(v, (int, float))]
+    return f" [{min(values):.1f}-{max(values):.1f}]" if len(values) > 1 else ""
+
+
+def host_check(args, seconds=10):
+    """The host's preemption of the client's core, as bench/host_jitter sees it (None if absent)."""
+    exe = os.path.join(args.build_dir, "bench", "host_jitter")
+    if not os.path.exists(exe):
+        return None
+    out = subprocess.run(pinned([exe, str(seconds)], args.client_cpu), capture_output=True,
+                         text=True)
+    return json.loads(out.stdout) if out.returncode == 0 else None
+
+
+def host_line(before, after):
+    parts = [f"{label} the runs: {h['gaps']} gaps over {h['threshold_ms']:.0f} ms in "
+             f"{h['seconds']:.0f} s ({h['gaps_over_20ms']} over 20 ms), {h['lost_ms']:.0f} ms lost, "
+             f"worst {h['worst_ms']:.0f} ms" for label, h in (("before", before), ("after", after))
+             if h]
+    if not parts:
+        return ""
+    return ("Host preemption of the client core (`bench/host_jitter`, a busy loop pinned there, "
+            "nothing else running): " + "; ".join(parts) + ".")
+
+
 def f1(v, scale=1.0):
     return "-" if v is None else f"{v * scale:.1f}"
 
@@ -459,7 +486,8 @@ def adapt_cell(runs):
 
 
 def table(results, args):
-    lines = ["| link | mode | frames | tracked | e2e ms median / p90 | client ms median | "
+    lines = ["| link | mode | frames | tracked | e2e ms median [runs' min-max] / p90 "
+             "| client ms median | "
              "slice latency ms median / p90 | uplink MB | downlink MB | ATE final cm | "
              "switches | frames per config (rows 1-5) | probe kB |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
@@ -475,7 +503,8 @@ def table(results, args):
             lines.append(
                 f"| {profile} | {variant_name(mode, adapt)} | {runs[0].get('frames', '-')} "
                 f"| {fmt_count(median_of(runs, 'tracked'))} "
-                f"| {f1(median_of(runs, 'e2e_ms', 'median'))} / {f1(median_of(runs, 'e2e_ms', 'p90'))} "
+                f"| {f1(median_of(runs, 'e2e_ms', 'median'))}{range_of(runs, 'e2e_ms', 'median')} / "
+                f"{f1(median_of(runs, 'e2e_ms', 'p90'))} "
                 f"| {f1(median_of(runs, 'client_ms', 'median'))} "
                 f"| {slice_ms} "
                 f"| {f2(median_of(runs, 'uplink_bytes'), 1e-6)} "
@@ -578,6 +607,7 @@ def main():
     if not gt_positions:
         print(f"no 7-Scenes poses in {args.dataset}: no error CDF", file=sys.stderr)
 
+    host_before = host_check(args)
     work = args.keep or tempfile.mkdtemp(prefix="link-bench-")
     results, errors, failures = {}, {}, []
     total = len(args.profiles) * len(VARIANTS) * args.runs
@@ -610,7 +640,8 @@ def main():
         if not args.keep:
             shutil.rmtree(work, ignore_errors=True)
 
-    text = table(results, args)
+    host = host_line(host_before, host_check(args))
+    text = table(results, args) + (f"\n\n{host}" if host else "")
     print(text)
     for key, errs in sorted(errors.items(), key=lambda kv: str(kv[0])):
         if errs:

@@ -58,6 +58,28 @@ def run_once(binary, dataset, sensor, mode, cpu, port, feed):
             return json.load(f)
 
 
+def host_check(build, cpu, seconds=10):
+    """The host's preemption of the client's core, as bench/host_jitter sees it (None if absent)."""
+    exe = os.path.join(build, "bench", "host_jitter")
+    if not os.path.exists(exe):
+        return None
+    out = subprocess.run(pinned([exe, str(seconds)], cpu), capture_output=True, text=True)
+    return json.loads(out.stdout) if out.returncode == 0 else None
+
+
+def host_line(before, after):
+    parts = []
+    for label, h in (("before", before), ("after", after)):
+        if h:
+            parts.append(f"{label} the runs: {h['gaps']} gaps over {h['threshold_ms']:.0f} ms in "
+                         f"{h['seconds']:.0f} s ({h['gaps_over_20ms']} over 20 ms), "
+                         f"{h['lost_ms']:.0f} ms lost, worst {h['worst_ms']:.0f} ms")
+    if not parts:
+        return ""
+    return ("Host preemption of the client core (`bench/host_jitter`, a busy loop pinned there; "
+            "no other work running): " + "; ".join(parts) + ".")
+
+
 def spread(values, fmt):
     return f"{fmt(statistics.median(values))} [{fmt(min(values))}-{fmt(max(values))}]"
 
@@ -85,6 +107,7 @@ def main():
              "| uplink KB per keyframe (per frame offload) | slice latency ms median | ORB-SLAM2 ATE "
              "| ORB-SLAM2 ms median / p90 |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    host_before = host_check(args.build, cpu)
     for key, mode in [(k, m) for k in args.rows.split(",") for m in args.modes.split(",")]:
         name, rel, sensor, ref_ate, ref_ms = ROWS[key]
         dataset = os.path.join(args.shared, rel)
@@ -120,7 +143,8 @@ def main():
             f"| {f1(statistics.median(up)) if mode != 'local' else '-'} "
             f"| {f1(statistics.median(slice_ms)) if mode == 'edge' else '-'} "
             f"| {ref_ate} | {ref_ms} |")
-    table = "\n".join(lines)
+    host = host_line(host_before, host_check(args.build, cpu))
+    table = "\n".join(lines) + (f"\n\n{host}" if host else "")
     print(table)
     if not args.no_docs:
         path = os.path.join(root, "docs", "benchmarks.md")

@@ -19,9 +19,13 @@ struct FrameLogEntry {
   double load_ms = 0.0;
   double client_ms = 0.0;
   double e2e_ms = 0.0;
+  double features_ms = 0.0;  // client_ms split by stage (zero in offload mode)
+  double tracking_ms = 0.0;
+  double keyframe_ms = 0.0;
 };
 
-// Columns: frame,timestamp,state,keyframe,relocalized,tracked_points,load_ms,client_ms,e2e_ms.
+// Columns: frame,timestamp,state,keyframe,relocalized,tracked_points,load_ms,client_ms,e2e_ms,
+// features_ms,tracking_ms,keyframe_ms.
 // Throws std::runtime_error naming the file when it cannot be written.
 void writeFrameLog(const std::filesystem::path& path, const std::vector<FrameLogEntry>& entries);
 

@@ -15,6 +15,7 @@
 #include "frame_log.h"
 #include "io/camera_file.h"
 #include "io/dataset.h"
+#include "io/frame_prefetcher.h"
 #include "io/trajectory.h"
 #include "link/link_settings.h"
 #include "pipeline/edge_slam.h"
@@ -164,6 +165,9 @@ int runPipeline(const RunOptions& options) {
   const std::string mode = options.mode;
 
   SlamOptions slam_options = defaultSlamOptions(reader->camera(), sensor);
+  if (mode == "edge") {
+    slam_options.orb.num_features = std::min(slam_options.orb.num_features, kEdgeClientMaxFeatures);
+  }
   if (options.features) slam_options.orb.num_features = *options.features;
   if (options.levels) slam_options.orb.num_levels = *options.levels;
   KeyFrameParameters& kf = slam_options.tracker.keyframes;
@@ -217,13 +221,22 @@ int runPipeline(const RunOptions& options) {
   std::optional<SemanticEvaluation> semantic_eval = SemanticEvaluation::open(info.path);
   if (semantic_eval) spdlog::info("ground-truth masks found: scoring the semantic culling");
   const auto& stamps = reader->timestamps();
+  // Paced runs read ahead on a thread of their own, and a frame waits for its time after it is
+  // decoded: a camera hands over decoded frames at their timestamps, so reading the dataset's
+  // files is not the tracker's latency (load_ms reports it; it still counts when reading makes a
+  // frame late). Unpaced runs read each frame when they come to it.
+  std::optional<FramePrefetcher> prefetcher;
+  if (options.realtime) {
+    prefetcher.emplace(
+        *reader, frame_count,
+        FramePrefetcherOptions{.frames_ahead = 4, .thread_nice = slam_options.background_nice});
+  }
   for (std::size_t i = 0; i < frame_count; ++i) {
-    // Read and decode first, then wait for the frame's time: a camera hands over a decoded frame
-    // at its timestamp, so decoding the dataset's files is not the tracker's latency (load_ms
-    // reports it; it still counts when reading alone makes a frame late).
     Stopwatch load_timer;
-    const DatasetFrame frame = reader->load(i);
-    load_ms.add(load_timer.elapsedMs());
+    const PrefetchedFrame prefetched =
+        prefetcher ? prefetcher->next() : PrefetchedFrame{reader->load(i), 0.0};
+    const DatasetFrame& frame = prefetched.frame;
+    load_ms.add(prefetcher ? prefetched.load_ms : load_timer.elapsedMs());
     if (options.realtime && i > 0) {
       const double due_ms = (stamps[i] - stamps[0]) * 1000.0;
       const double wait_ms = due_ms - wall.elapsedMs();
@@ -243,9 +256,10 @@ int runPipeline(const RunOptions& options) {
       frame_e2e_ms = std::max(processing_ms, wall.elapsedMs() - due_ms);
     }
     e2e_ms.add(frame_e2e_ms);
+    const ClientStageTimes stages = slam.lastFrameStages();
     frame_log.push_back({i, frame.timestamp, result.state, result.new_keyframe, result.relocalized,
                          result.tracked_points, load_ms.samples().back(), processing_ms,
-                         frame_e2e_ms});
+                         frame_e2e_ms, stages.features_ms, stages.tracking_ms, stages.keyframe_ms});
     if (result.state == TrackingState::kOk) {
       ++tracked;
     } else if (result.state == TrackingState::kLost) {
@@ -299,6 +313,11 @@ int runPipeline(const RunOptions& options) {
                             {"dataset", info.path.string()},
                             {"wall_s", seconds},
                             {"load_ms", toJson(load_ms.summary())}};
+  if (counters.features_ms.count > 0) {
+    metrics["client_stages_ms"] = {{"features", toJson(counters.features_ms)},
+                                   {"tracking", toJson(counters.tracking_ms)},
+                                   {"keyframe", toJson(counters.keyframe_ms)}};
+  }
   if (const auto* edge_slam = dynamic_cast<const EdgeSlam*>(&slam);
       edge_slam != nullptr && edge_slam->adaptation() != nullptr) {
     const AdaptationLoop& loop = *edge_slam->adaptation();
@@ -377,6 +396,11 @@ int runPipeline(const RunOptions& options) {
   }
   fmt::print("  client ms    median {:.2f}  p90 {:.2f}  p99 {:.2f}  max {:.2f}\n", client.median,
              client.p90, client.p99, client.max);
+  if (counters.features_ms.count > 0) {
+    fmt::print("  stages ms    features {:.2f}  tracking {:.2f}  keyframe {:.2f} (medians)\n",
+               counters.features_ms.median, counters.tracking_ms.median,
+               counters.keyframe_ms.median);
+  }
   if (options.semantic) {
     fmt::print(
         "  semantic     {} keyframes segmented ({:.0f} ms median), {} features culled, transfer "
@@ -464,8 +488,10 @@ void addRunOptions(CLI::App* run, const std::shared_ptr<RunOptions>& options) {
                   "(on|off, default on)")
       ->transform(
           CLI::CheckedTransformer(std::map<std::string, bool>{{"on", true}, {"off", false}}));
-  run->add_option("--features", options->features,
-                  "ORB features per frame (default 1000, 2000 above 640x480)")
+  run->add_option(
+         "--features", options->features,
+         "ORB features per frame (default 1000, 2000 above 640x480; edge mode at most 1600, "
+         "which keeps a keyframe upload within about 60 KB)")
       ->check(CLI::Range(100, 20000));
   run->add_option("--levels", options->levels, "ORB pyramid levels (Table I nl)")
       ->check(CLI::Range(1, 12));

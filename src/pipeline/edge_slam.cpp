@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <mutex>
 #include <thread>
 
 #include "client/slice_applier.h"
@@ -107,13 +108,14 @@ void EdgeSlam::afterFrame() {
   if (!forgotten.empty()) tracker_->onMapWindowChanged(forgotten, {});
   {
     // Tracking adds keyframes and points between slices: the client map's peak is seen here.
-    std::size_t keyframes = 0, points = 0;
-    {
-      std::lock_guard lock(map_.updateMutex());
-      keyframes = map_.heldKeyFrameCount();
-      points = map_.pointCount();
+    // Not worth waiting for a slice being applied (it notes the size itself when done).
+    std::unique_lock lock(map_.updateMutex(), std::try_to_lock);
+    if (lock.owns_lock()) {
+      const std::size_t keyframes = map_.heldKeyFrameCount();
+      const std::size_t points = map_.pointCount();
+      lock.unlock();
+      noteClientMapSize(keyframes, points);
     }
-    noteClientMapSize(keyframes, points);
   }
   if (!adaptation_) return;
   adaptation_->onFrame();  // counted under the configuration this frame ran with
@@ -231,7 +233,7 @@ SlamCounters EdgeSlam::counters() const {
   out.slice_apply_ms = slice_apply_ms_.summary();
   out.keyframes_segmented = keyframes_segmented_;
   out.segmentation_ms = segmentation_ms_.summary();
-  addSemanticCounters(out);
+  addClientCounters(out);
   return out;
 }
 

@@ -77,7 +77,7 @@ void LocalSlam::finish() {
 SlamCounters LocalSlam::counters() const {
   SlamCounters out;
   if (loop_closer_) out.loops = loop_closer_->loops();
-  addSemanticCounters(out);
+  addClientCounters(out);
   if (segmentation_) {
     const KeyFrameSegmentationCounters c = segmentation_->counters();
     out.keyframes_segmented = c.segmented;

@@ -50,6 +50,7 @@ void TrackingSlam::startTracking(KeyFrameSink* sink) {
 TrackResult TrackingSlam::process(std::size_t frame_index, double timestamp, const cv::Mat& gray,
                                   const cv::Mat& depth, const cv::Mat& color) {
   const cv::Mat& used_depth = options_.sensor == Sensor::kMonocular ? cv::Mat() : depth;
+  Stopwatch stage;
   std::shared_ptr<const FrameFeatures> features =
       buildFrameFeatures(gray, used_depth, camera_, extractor_, options_.depth);
   if (semantic_filter_) {
@@ -59,15 +60,26 @@ TrackResult TrackingSlam::process(std::size_t frame_index, double timestamp, con
   } else {
     last_semantic_ = SemanticFrame{features, features, {}, std::nullopt, 0, 0.0};
   }
+  last_stages_.features_ms = stage.elapsedMs();
+  features_ms_.add(last_stages_.features_ms);
   const cv::Mat& image = color.empty() ? gray : color;
   beforeTracking(frame_index, image);
+  stage = Stopwatch();
   TrackResult result = tracker_->track(frame_index, timestamp, std::move(features));
+  last_stages_.tracking_ms = stage.elapsedMs();
+  tracking_ms_.add(last_stages_.tracking_ms);
+  stage = Stopwatch();
   afterTracking(result, frame_index, image);
   afterFrame();
+  last_stages_.keyframe_ms = stage.elapsedMs();
+  keyframe_ms_.add(last_stages_.keyframe_ms);
   return result;
 }
 
-void TrackingSlam::addSemanticCounters(SlamCounters& counters) const {
+void TrackingSlam::addClientCounters(SlamCounters& counters) const {
+  counters.features_ms = features_ms_.summary();
+  counters.tracking_ms = tracking_ms_.summary();
+  counters.keyframe_ms = keyframe_ms_.summary();
   if (!semantic_filter_) return;
   const SemanticFilterCounters c = semantic_filter_->counters();
   counters.semantic_client_ms = semantic_ms_.summary();

@@ -56,8 +56,21 @@ struct SlamOptions {
 // Nice 10 gives a thread about a tenth of the CPU against a nice-0 one.
 inline constexpr int kBackgroundNiceWhenPaced = 10;
 
+// Edge mode's client extracts at most this many features: an upload costs about 37 bytes per
+// feature (a 32-byte descriptor, ~5 bytes of keypoint), so a keyframe stays within ~60 KB. On KITTI
+// 07 (2000 features otherwise) it took uploads from 72 to 58 KB, with the ATE of 3 runs each
+// within their spread (33.3 [29.8-37.0] cm against 34.3 [33.2-34.7]).
+inline constexpr int kEdgeClientMaxFeatures = 1600;
+
 // Sensible defaults for a camera: 1000 features up to 640x480-ish, 2000 for wide images (KITTI).
 SlamOptions defaultSlamOptions(const PinholeCamera& camera, Sensor sensor);
+
+// Where one frame's client time went (zero where the client does not track: offload).
+struct ClientStageTimes {
+  double features_ms = 0.0;  // ORB extraction, undistortion, depth lookup (and semantic culling)
+  double tracking_ms = 0.0;  // pose estimation and local-map tracking
+  double keyframe_ms = 0.0;  // keyframe insertion, upload and the rest of the frame
+};
 
 // Network and edge figures; zero in local mode.
 struct SlamCounters {
@@ -81,6 +94,10 @@ struct SlamCounters {
   PercentileSummary semantic_client_ms;     // mask transfer and culling per frame
   std::uint64_t frames_with_mask = 0;
   std::uint64_t features_culled = 0;
+  // Where the client's time per frame goes (modes that track on the client).
+  PercentileSummary features_ms;  // ORB extraction, undistortion, depth lookup
+  PercentileSummary tracking_ms;  // pose estimation and local-map tracking
+  PercentileSummary keyframe_ms;  // keyframe insertion, upload and the rest of the frame
 };
 
 // One run mode's whole SLAM as the run command drives it.
@@ -110,6 +127,7 @@ class SlamSystem {
   // The last frame's semantic stage (mask, culled features); nullptr where the client does not
   // track (offload).
   virtual const SemanticFrame* lastSemanticFrame() const { return nullptr; }
+  virtual ClientStageTimes lastFrameStages() const { return {}; }
 };
 
 // Modes that track on the client against the client's map: feature extraction and tracking on the
@@ -130,6 +148,7 @@ class TrackingSlam : public SlamSystem {
   std::size_t mapResets() const override { return tracker_->resets(); }
   // Always present: without semantic culling, every feature is kept and there is no mask.
   const SemanticFrame* lastSemanticFrame() const override { return &last_semantic_; }
+  ClientStageTimes lastFrameStages() const override { return last_stages_; }
 
   const Tracker& tracker() const { return *tracker_; }
   // The client's map (lock its update mutex while reading it during a run).
@@ -143,8 +162,8 @@ class TrackingSlam : public SlamSystem {
   virtual void afterFrame() {}
   virtual void afterTracking(const TrackResult& /*result*/, std::size_t /*frame_index*/,
                              const cv::Mat& /*image*/) {}
-  // The semantic stage's figures, for the subclasses' counters().
-  void addSemanticCounters(SlamCounters& counters) const;
+  // The semantic stage's and the per-stage timing figures, for the subclasses' counters().
+  void addClientCounters(SlamCounters& counters) const;
 
   PinholeCamera camera_;
   SlamOptions options_;
@@ -156,6 +175,10 @@ class TrackingSlam : public SlamSystem {
  private:
   SemanticFrame last_semantic_;
   SampleStats semantic_ms_;
+  ClientStageTimes last_stages_;
+  SampleStats features_ms_;
+  SampleStats tracking_ms_;
+  SampleStats keyframe_ms_;
 };
 
 }  // namespace edgeslam

@@ -49,11 +49,20 @@ TEST(RunCommand, WritesTheContractOutputs) {
   for (const char* stat : {"median", "p90", "p99", "max"}) {
     EXPECT_GT(metrics["client_ms"][stat].get<double>(), 0.0) << stat;
   }
+  // The client's time split by stage: extraction and tracking take time on every frame.
+  for (const char* stage : {"features", "tracking", "keyframe"}) {
+    ASSERT_TRUE(metrics["client_stages_ms"].contains(stage)) << stage;
+  }
+  EXPECT_GT(metrics["client_stages_ms"]["features"]["median"].get<double>(), 0.0);
+  EXPECT_GT(metrics["client_stages_ms"]["tracking"]["median"].get<double>(), 0.0);
+  EXPECT_LE(metrics["client_stages_ms"]["features"]["median"].get<double>(),
+            metrics["client_ms"]["max"].get<double>());
   // One row per frame after the header, each with its state and times.
   std::ifstream frames(out / "frames.csv");
   std::string line;
   ASSERT_TRUE(std::getline(frames, line));
   EXPECT_EQ(line.rfind("frame,timestamp,state,keyframe", 0), 0u) << line;
+  EXPECT_NE(line.find(",features_ms,tracking_ms,keyframe_ms"), std::string::npos) << line;
   std::size_t rows = 0, keyframes = 0;
   while (std::getline(frames, line)) {
     ++rows;
