@@ -158,6 +158,10 @@ int runPipeline(const RunOptions& options) {
     throw std::invalid_argument("--sensor stereo is not supported yet; use mono or rgbd");
   }
   const Sensor sensor = toSensor(sensor_name);
+  // Decode only what the run uses: colour is for segmenting keyframes, depth for RGB-D.
+  reader->setContent({.color = options.semantic,
+                      .depth = sensor == Sensor::kRgbd,
+                      .right = sensor == Sensor::kStereo});
   const std::size_t frame_count =
       options.max_frames > 0 ? std::min(options.max_frames, info.frame_count) : info.frame_count;
   spdlog::info("dataset {} ({}, {} frames, {} fps), camera {}", info.path.string(),

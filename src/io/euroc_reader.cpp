@@ -226,9 +226,9 @@ class EurocReader : public TabulatedReader {
     DatasetFrame frame = beginFrame(index, std::string());
     const std::filesystem::path& left = left_.files[index];
     frame.name = left.filename().string();
-    setImages(readImage(left), left, frame);
+    readFrameImage(left, content_.color, frame);
     checkImageSize(frame.gray, imageSize(camera_), left, "image");
-    if (!right_files_.empty() && !right_files_[index].empty()) {
+    if (!right_files_.empty() && !right_files_[index].empty() && content_.right) {
       DatasetFrame right;
       setImages(readImage(right_files_[index]), right_files_[index], right);
       checkImageSize(right.gray, imageSize(camera_), right_files_[index], "right image");

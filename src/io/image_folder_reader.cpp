@@ -65,7 +65,7 @@ class ImageFolderReader : public TabulatedReader {
     DatasetFrame frame = beginFrame(index, std::string());
     const std::filesystem::path& image = images_[index];
     frame.name = image.filename().string();
-    setImages(readImage(image), image, frame);
+    readFrameImage(image, content_.color, frame);
     checkImageSize(frame.gray, imageSize(camera_), image, "image");
     return frame;
   }

@@ -122,9 +122,9 @@ class KittiReader : public TabulatedReader {
   DatasetFrame load(std::size_t index) override {
     DatasetFrame frame = beginFrame(index, std::string());
     frame.name = left_[index].filename().string();
-    setImages(readImage(left_[index]), left_[index], frame);
+    readFrameImage(left_[index], content_.color, frame);
     checkImageSize(frame.gray, imageSize(camera_), left_[index], "image");
-    if (!right_.empty()) {
+    if (!right_.empty() && content_.right) {
       DatasetFrame right;
       setImages(readImage(right_[index]), right_[index], right);
       checkImageSize(right.gray, imageSize(camera_), right_[index], "right image");

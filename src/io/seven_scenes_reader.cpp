@@ -141,9 +141,9 @@ class SevenScenesReader : public TabulatedReader {
     DatasetFrame frame = beginFrame(index, std::string());
     const std::filesystem::path& color = color_files_[index];
     frame.name = color.filename().string();
-    setImages(readImage(color), color, frame);
+    readFrameImage(color, content_.color, frame);
     checkImageSize(frame.gray, imageSize(camera_), color, "image");
-    if (info_.has_depth) {
+    if (info_.has_depth && content_.depth) {
       const auto depth = sibling(color, ".depth.png");
       frame.depth =
           depthToMetres(readImage(depth), camera_.intrinsics().depth_factor, depth, kInvalidDepth);

@@ -186,9 +186,9 @@ class TumReader : public TabulatedReader {
     DatasetFrame frame = beginFrame(index, std::string());
     const std::filesystem::path& rgb = rgb_files_[index];
     frame.name = rgb.filename().string();
-    setImages(readImage(rgb), rgb, frame);
+    readFrameImage(rgb, content_.color, frame);
     checkImageSize(frame.gray, imageSize(camera_), rgb, "image");
-    if (const auto& depth = depth_files_[index]) {
+    if (const auto& depth = depth_files_[index]; depth && content_.depth) {
       frame.depth = depthToMetres(readImage(*depth), camera_.intrinsics().depth_factor, *depth);
       checkImageSize(frame.depth, imageSize(camera_), *depth, "depth image");
     }

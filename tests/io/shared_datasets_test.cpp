@@ -72,6 +72,30 @@ TEST(SharedSevenScenes, FramesDepthAndGroundTruth) {
   EXPECT_NEAR(expected(0, 3), -0.34045634, 1e-8);  // the file really was read
 }
 
+TEST(SharedSevenScenes, GreyOnlyContentSkipsColourAndDepth) {
+  EDGESLAM_REQUIRE_SHARED(kSevenScenes);
+  auto reader = openDataset(sharedPath(kSevenScenes));
+  const DatasetFrame full = reader->load(7);
+  reader->setContent({.color = false, .depth = false, .right = false});
+  const DatasetFrame grey = reader->load(7);
+  EXPECT_TRUE(grey.color.empty());
+  EXPECT_TRUE(grey.depth.empty());
+  ASSERT_EQ(grey.gray.size(), full.gray.size());
+  ASSERT_EQ(grey.gray.type(), CV_8UC1);
+  // The JPEG's own luma against the BGR-to-grey conversion: the same image up to rounding.
+  cv::Mat difference;
+  cv::absdiff(grey.gray, full.gray, difference);
+  EXPECT_LT(cv::mean(difference)[0], 1.5);
+  EXPECT_EQ(grey.timestamp, full.timestamp);
+  ASSERT_TRUE(grey.ground_truth.has_value());
+
+  reader->setContent({.color = false, .depth = true, .right = false});
+  const DatasetFrame with_depth = reader->load(7);
+  EXPECT_TRUE(with_depth.color.empty());
+  ASSERT_EQ(with_depth.depth.size(), full.depth.size());
+  EXPECT_EQ(cv::norm(with_depth.depth, full.depth, cv::NORM_INF), 0.0);
+}
+
 TEST(SharedSevenScenes, LoadingAFrameTakesAFewMilliseconds) {
   EDGESLAM_REQUIRE_SHARED(kSevenScenes);
   auto reader = openDataset(sharedPath(kSevenScenes));
