@@ -148,6 +148,10 @@ std::unique_ptr<SlamSystem> makeSlamSystem(const RunOptions& options, const std:
 }
 
 int runPipeline(const RunOptions& options) {
+  if (options.viewer_port != 0) {
+    spdlog::warn("--viewer {}: the web viewer is not part of this build yet; running without it",
+                 options.viewer_port);
+  }
   DatasetOptions dataset_options;
   dataset_options.format = parseDatasetFormat(options.format);
   if (options.camera_file) dataset_options.camera_override = loadCameraFile(*options.camera_file);
@@ -471,7 +475,8 @@ void addRunOptions(CLI::App* run, const std::shared_ptr<RunOptions>& options) {
       ->excludes(realtime);
   run->add_option("--out", options->out_dir,
                   "Output folder (trajectories, metrics.json, frames.csv with each frame's times)");
-  run->add_option("--viewer", options->viewer_port, "Serve the web viewer on this port");
+  run->add_option("--viewer", options->viewer_port,
+                  "Serve the web viewer on this port (not built yet: warns and runs without it)");
   run->add_option("--camera", options->camera_file, "Camera YAML overriding the dataset's camera")
       ->check(CLI::ExistingFile);
   run->add_option("--vocab", options->vocabulary,

@@ -95,15 +95,8 @@ void setImages(const cv::Mat& image, const std::filesystem::path& path, DatasetF
 }
 
 void readFrameImage(const std::filesystem::path& path, bool color, DatasetFrame& frame) {
-  if (color) {
-    setImages(readImage(path), path, frame);
-    return;
-  }
-  if (!std::filesystem::exists(path)) {
-    throw DatasetError(fmt::format("image not found: {}", path.string()));
-  }
-  frame.gray = cv::imread(path.string(), cv::IMREAD_GRAYSCALE);
-  if (frame.gray.empty()) throw DatasetError(fmt::format("cannot decode image {}", path.string()));
+  setImages(readImage(path), path, frame);
+  if (!color) frame.color.release();
 }
 
 cv::Mat depthToMetres(const cv::Mat& raw, double depth_factor, const std::filesystem::path& path,

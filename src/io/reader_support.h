@@ -54,8 +54,11 @@ bool naturalLess(const std::string& a, const std::string& b);
 // Frame number of a 7-Scenes colour image name (frame-000123.color.png|jpg -> 123).
 std::optional<long> sevenScenesFrameNumber(const std::string& file_name);
 
-// Fills frame.gray, and frame.color when `color` is set and the image has colour (as setImages);
-// without `color` the file is decoded straight to grey. Throws DatasetError naming the file.
+// Fills frame.gray, and frame.color when `color` is set and the image has colour (as setImages).
+// Grey is always converted from the decoded colour, never decoded as the JPEG's own luma: the two
+// differ by a grey level here and there, and tracking must see the same frames whatever else a run
+// asks for (behind lte-congested, that difference decided whether a monocular client relocalised).
+// Throws DatasetError naming the file.
 void readFrameImage(const std::filesystem::path& path, bool color, DatasetFrame& frame);
 
 // Holds what every reader knows before loading images.
