@@ -38,6 +38,8 @@ import sys
 import tempfile
 import time
 
+from host_check import host_check, host_line
+
 PROFILES = ["none", "wifi5", "wifi24", "lte", "lte-congested"]
 VARIANTS = [("edge", "on"), ("edge", "off"), ("offload", None)]
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -441,27 +443,6 @@ def range_of(runs, *keys):
     return f" [{min(values):.1f}-{max(values):.1f}]" if len(values) > 1 else ""
 
 
-def host_check(args, seconds=10):
-    """The host's preemption of the client's core, as bench/host_jitter sees it (None if absent)."""
-    exe = os.path.join(args.build_dir, "bench", "host_jitter")
-    if not os.path.exists(exe):
-        return None
-    out = subprocess.run(pinned([exe, str(seconds)], args.client_cpu), capture_output=True,
-                         text=True)
-    return json.loads(out.stdout) if out.returncode == 0 else None
-
-
-def host_line(before, after):
-    parts = [f"{label} the runs: {h['gaps']} gaps over {h['threshold_ms']:.0f} ms in "
-             f"{h['seconds']:.0f} s ({h['gaps_over_20ms']} over 20 ms), {h['lost_ms']:.0f} ms lost, "
-             f"worst {h['worst_ms']:.0f} ms" for label, h in (("before", before), ("after", after))
-             if h]
-    if not parts:
-        return ""
-    return ("Host preemption of the client core (`bench/host_jitter`, a busy loop pinned there, "
-            "nothing else running): " + "; ".join(parts) + ".")
-
-
 def f1(v, scale=1.0):
     return "-" if v is None else f"{v * scale:.1f}"
 
@@ -607,7 +588,7 @@ def main():
     if not gt_positions:
         print(f"no 7-Scenes poses in {args.dataset}: no error CDF", file=sys.stderr)
 
-    host_before = host_check(args)
+    host_before = host_check(args.build_dir, args.client_cpu)
     work = args.keep or tempfile.mkdtemp(prefix="link-bench-")
     results, errors, failures = {}, {}, []
     total = len(args.profiles) * len(VARIANTS) * args.runs
@@ -640,7 +621,7 @@ def main():
         if not args.keep:
             shutil.rmtree(work, ignore_errors=True)
 
-    host = host_line(host_before, host_check(args))
+    host = host_line(host_before, host_check(args.build_dir, args.client_cpu))
     text = table(results, args) + (f"\n\n{host}" if host else "")
     print(text)
     for key, errs in sorted(errors.items(), key=lambda kv: str(kv[0])):

@@ -20,6 +20,8 @@ import sys
 import tempfile
 import time
 
+from host_check import host_check, host_line
+
 ROWS = {
     "mono": ("7-Scenes redkitchen 1000", "datasets/7scenes-redkitchen-1000", "mono",
              "4.40 cm [4.32-4.43]", "28.8 / 35.2"),
@@ -56,28 +58,6 @@ def run_once(binary, dataset, sensor, mode, cpu, port, feed):
                 server.wait(timeout=10)
         with open(os.path.join(out, "metrics.json")) as f:
             return json.load(f)
-
-
-def host_check(build, cpu, seconds=10):
-    """The host's preemption of the client's core, as bench/host_jitter sees it (None if absent)."""
-    exe = os.path.join(build, "bench", "host_jitter")
-    if not os.path.exists(exe):
-        return None
-    out = subprocess.run(pinned([exe, str(seconds)], cpu), capture_output=True, text=True)
-    return json.loads(out.stdout) if out.returncode == 0 else None
-
-
-def host_line(before, after):
-    parts = []
-    for label, h in (("before", before), ("after", after)):
-        if h:
-            parts.append(f"{label} the runs: {h['gaps']} gaps over {h['threshold_ms']:.0f} ms in "
-                         f"{h['seconds']:.0f} s ({h['gaps_over_20ms']} over 20 ms), "
-                         f"{h['lost_ms']:.0f} ms lost, worst {h['worst_ms']:.0f} ms")
-    if not parts:
-        return ""
-    return ("Host preemption of the client core (`bench/host_jitter`, a busy loop pinned there; "
-            "no other work running): " + "; ".join(parts) + ".")
 
 
 def spread(values, fmt):

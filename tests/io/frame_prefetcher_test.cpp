@@ -44,6 +44,7 @@ class CountingReader : public DatasetReader {
     ++loads;
     std::this_thread::sleep_for(load_delay_);
     if (index == fail_at_) throw DatasetError("frame " + std::to_string(index) + " is corrupt");
+    ++loaded;
     DatasetFrame frame;
     frame.index = index;
     frame.timestamp = stamps_[index];
@@ -51,7 +52,8 @@ class CountingReader : public DatasetReader {
     return frame;
   }
 
-  std::atomic<std::size_t> loads{0};
+  std::atomic<std::size_t> loads{0};   // loads started
+  std::atomic<std::size_t> loaded{0};  // loads finished
 
  private:
   DatasetInfo info_;
@@ -104,7 +106,11 @@ TEST(FramePrefetcher, ReadsWhileTheConsumerWorks) {
   CountingReader reader(10, kNever, std::chrono::milliseconds(100));
   FramePrefetcher prefetcher(reader, 10, {.frames_ahead = 4});
   prefetcher.next();
-  waitForLoads(reader, 5);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (reader.loaded.load() < 5 && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  ASSERT_EQ(reader.loaded.load(), 5u);
   const auto start = std::chrono::steady_clock::now();
   for (int i = 0; i < 4; ++i) prefetcher.next();
   const double waited_ms =

@@ -100,6 +100,22 @@ TEST(EdgeModeCommand, ClientAgainstASeparateServerProcess) {
   EXPECT_EQ(m["slices_applied"], m["keyframes_uploaded"]);
 }
 
+TEST(EdgeModeCommand, EdgeClientsExtractAtMost1600FeaturesUnlessAsked) {
+  EDGESLAM_REQUIRE_SHARED("datasets/kitti07-160");
+  const std::string common = "run --dataset " + test::sharedPath("datasets/kitti07-160").string() +
+                             " --sensor mono --max-frames 3 --vocab none --mode ";
+  // KITTI's wide images take 2000 features locally; an edge client's uploads stay near 60 KB.
+  const auto local = test::runEdgeslam(common + "local");
+  EXPECT_EQ(local.exit_code, 0) << local.output;
+  EXPECT_NE(local.output.find("2000 ORB features"), std::string::npos) << local.output;
+  const auto edge = test::runEdgeslam(common + "edge");
+  EXPECT_EQ(edge.exit_code, 0) << edge.output;
+  EXPECT_NE(edge.output.find("1600 ORB features"), std::string::npos) << edge.output;
+  const auto asked = test::runEdgeslam(common + "edge --features 1900");
+  EXPECT_EQ(asked.exit_code, 0) << asked.output;
+  EXPECT_NE(asked.output.find("1900 ORB features"), std::string::npos) << asked.output;
+}
+
 TEST(EdgeModeCommand, ClientWithoutServerIsAClearError) {
   EDGESLAM_REQUIRE_SHARED(kSequence);
   const auto r = test::runEdgeslam("client --server 127.0.0.1:1 --dataset " +
