@@ -186,6 +186,7 @@ int runPipeline(const RunOptions& options) {
   if (options.starving) kf.starving_ratio = *options.starving;
   slam_options.orb.validate();
   slam_options.tracker.vocabulary = loadVocabulary(options.vocabulary);
+  slam_options.tracker.recover_within_frames = options.recover_frames;
   slam_options.vocabulary = slam_options.tracker.vocabulary;
   slam_options.loop_closing = options.loop_closing;
   slam_options.client_triangulation = options.client_triangulation;
@@ -198,6 +199,7 @@ int runPipeline(const RunOptions& options) {
   }
   slam_options.semantic = options.semantic;
   slam_options.keyframe_image_reduce = options.segment_reduce;
+  slam_options.segmentation_refresh_frames = options.segment_refresh;
   if (options.semantic && options.server_address.empty()) {
     // The segmenter runs on its own thread beside tracking (and, embedded, beside the edge's
     // mapping) in this process; OpenCV's default pool would spread each inference over every
@@ -314,6 +316,7 @@ int runPipeline(const RunOptions& options) {
                             {"segmentation_ms", toJson(counters.segmentation_ms)},
                             {"loops", counters.loops},
                             {"relocalizations", slam.relocalizations()},
+                            {"tracking_recoveries", slam.trackingRecoveries()},
                             {"map_resets", slam.mapResets()},
                             {"mode", mode},
                             {"requested_mode", options.mode},
@@ -386,8 +389,10 @@ int runPipeline(const RunOptions& options) {
   fmt::print("  mode/sensor  {} / {}\n", mode, sensor_name);
   fmt::print("  frames       {} in {:.2f} s ({:.1f} fps), tracked {}, lost {}\n", frame_count,
              seconds, static_cast<double>(frame_count) / std::max(seconds, 1e-9), tracked, lost);
-  fmt::print("  map          {} keyframes, {} points, {} relocalisations, {} resets\n",
-             slam.keyFrameCount(), slam.mapPointCount(), slam.relocalizations(), slam.mapResets());
+  fmt::print(
+      "  map          {} keyframes, {} points, {} relocalisations, {} recoveries, {} resets\n",
+      slam.keyFrameCount(), slam.mapPointCount(), slam.relocalizations(), slam.trackingRecoveries(),
+      slam.mapResets());
   if (const auto* edge_slam = dynamic_cast<const EdgeSlam*>(&slam)) {
     const ClientMapSize c = edge_slam->clientMapSize();
     fmt::print("  client map   {} keyframes, {} points held (at most {} / {}; window {})\n",
@@ -467,6 +472,17 @@ void addRunOptions(CLI::App* run, const std::shared_ptr<RunOptions>& options) {
   run->add_option("--segment-reduce", options->segment_reduce,
                   "Keyframes are segmented at 1/N of full size (the image sent to the edge)")
       ->check(CLI::Range(1, 8))
+      ->capture_default_str();
+  run->add_option("--segment-refresh", options->segment_refresh,
+                  "With semantic culling, a keyframe (and so a segmentation) at least every N "
+                  "frames of a 30 fps camera, so that people walking into view are masked soon "
+                  "(0 = keyframes by the usual rules only)")
+      ->check(CLI::Range(0, 1000))
+      ->capture_default_str();
+  run->add_option("--recover-frames", options->recover_frames,
+                  "After tracking fails, for up to N frames the camera is assumed to keep its "
+                  "velocity and is searched for there before relocalisation (0 = off)")
+      ->check(CLI::Range(0, 300))
       ->capture_default_str();
   run->add_option("--max-frames", options->max_frames, "Process at most N frames (0 = all)");
   auto* realtime = run->add_flag("--realtime", options->realtime,

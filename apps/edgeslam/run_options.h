@@ -5,6 +5,8 @@
 #include <optional>
 #include <string>
 
+#include "pipeline/slam_system.h"
+
 namespace edgeslam::cli {
 
 struct RunOptions {
@@ -19,9 +21,12 @@ struct RunOptions {
   std::filesystem::path models_dir;  // segmentation models; "" = the shared models folder
   int segment_input = 256;           // detector input side
   int segment_reduce = 2;            // keyframes are segmented at 1/this of full size
-  std::size_t max_frames = 0;        // 0 = all
-  bool realtime = false;             // feed at the dataset's rate (default: as fast as possible)
-  bool fast = false;                 // explicit request for the default
+  int segment_refresh = SlamOptions{}.segmentation_refresh_frames;  // 0 = no refresh keyframes
+  // Lost frames bridged by the motion prediction (TrackerOptions::recover_within_frames).
+  std::size_t recover_frames = TrackerOptions{}.recover_within_frames;
+  std::size_t max_frames = 0;  // 0 = all
+  bool realtime = false;       // feed at the dataset's rate (default: as fast as possible)
+  bool fast = false;           // explicit request for the default
   std::filesystem::path out_dir;
   int viewer_port = 0;
   std::optional<std::filesystem::path> camera_file;

@@ -33,6 +33,7 @@ struct SegmentOptions {
   std::string classes = "default";
   float nm = 0.8f;
   float score = 0.3f;
+  float border_score = SegmenterOptions{}.border_score_threshold;
   int repeat = 1;
   int mask_downscale = 2;
   int threads = 0;
@@ -111,11 +112,12 @@ void runSegment(const SegmentOptions& o) {
   options.classes = parseClassList(o.classes);
   options.nms_threshold = o.nm;
   options.score_threshold = o.score;
+  options.border_score_threshold = o.border_score;
   options.detector_input_size = o.input_size;
   const auto segmenter = makeSegmenter(options);
-  fmt::print("segmenter {} (models {}), classes {}, nm {:.2f}, score {:.2f}\n",
+  fmt::print("segmenter {} (models {}), classes {}, nm {:.2f}, score {:.2f} ({:.2f} at the edge)\n",
              segmenter->backendName(), options.model_dir.string(),
-             classListToString(options.classes), o.nm, o.score);
+             classListToString(options.classes), o.nm, o.score, o.border_score);
   if (!o.truth.empty()) {
     scoreSegmenterOnSequence(*segmenter, o.truth, {o.every, o.reduce});
     return;
@@ -165,6 +167,12 @@ void addSegmentCommand(CLI::App& app) {
       ->check(CLI::Range(0.0f, 1.0f))
       ->capture_default_str();
   segment->add_option("--score", options->score, "Detection score threshold")
+      ->check(CLI::Range(0.0f, 1.0f))
+      ->capture_default_str();
+  segment
+      ->add_option("--border-score", options->border_score,
+                   "Detection score threshold for boxes that reach the image's edge (people "
+                   "walking into view score lower)")
       ->check(CLI::Range(0.0f, 1.0f))
       ->capture_default_str();
   segment

@@ -83,6 +83,7 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
 
   KeyFrame* new_keyframe = nullptr;
   bool ok = false;
+  bool recovered = false;  // by the motion prediction, after some lost frames
   {
     std::lock_guard lock(map_.updateMutex());
     if (last_frame_ && last_frame_->T_cw) {
@@ -97,8 +98,14 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
       ok = velocity_ && trackWithMotionModel(frame);
       if (!ok) ok = trackReferenceKeyFrame(frame);
     } else {
-      ok = relocalize(frame);
-      if (ok) {
+      if (canRecoverByPrediction(frame_index) && trackByPrediction(frame)) {
+        ok = true;
+        recovered = true;
+      } else {
+        ok = relocalize(frame);
+      }
+      if (ok && !recovered) {
+        velocity_.reset();  // the camera may be anywhere: no motion carries over the gap
         result.relocalized = true;
         ++relocalizations_;
         last_relocalization_frame_ = frame_index;
@@ -118,9 +125,16 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
     }
 
     if (ok) {
+      if (recovered) {
+        ++recoveries_;
+        spdlog::info("tracking recovered at frame {} by the motion prediction, {} frames lost",
+                     frame_index, frames_lost_);
+      }
       if (state_ != TrackingState::kOk) frames_lost_ = 0;
       state_ = TrackingState::kOk;
-      if (last_frame_ && last_frame_->T_cw) {
+      // After a gap the difference to the last tracked frame spans several frames: the velocity
+      // that bridged it stays.
+      if (last_frame_ && last_frame_->T_cw && last_frame_->index + 1 == frame_index) {
         velocity_ = *frame.T_cw * last_frame_->T_cw->inverse();
       }
       if (isKeyFrame(decide(frame, inliers))) new_keyframe = createKeyFrame(frame);
@@ -128,8 +142,8 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
     } else {
       if (state_ == TrackingState::kOk) spdlog::warn("tracking lost at frame {}", frame_index);
       state_ = TrackingState::kLost;
-      velocity_.reset();
       ++frames_lost_;
+      if (!canRecoverByPrediction(frame_index + 1)) velocity_.reset();
     }
     for (std::size_t i = 0; i < frame.size(); ++i) {
       if (frame.outliers[i]) {
@@ -272,6 +286,38 @@ bool Tracker::trackWithMotionModel(Frame& frame) {
   const int inliers = discardOutliers(frame);
   spdlog::debug("frame {}: motion model {} matches, {} inliers", frame.index, matches, inliers);
   return inliers >= options_.min_inliers_motion;
+}
+
+bool Tracker::canRecoverByPrediction(std::size_t frame_index) const {
+  return options_.recover_within_frames > 0 && velocity_ && last_frame_ && last_frame_->T_cw &&
+         frame_index > last_frame_->index &&
+         frame_index - last_frame_->index <= options_.recover_within_frames;
+}
+
+bool Tracker::trackByPrediction(Frame& frame) {
+  const Frame& last = *last_frame_;
+  SE3d since_last;
+  for (std::size_t i = last.index; i < frame.index; ++i) since_last = *velocity_ * since_last;
+  frame.T_cw = since_last * *last.T_cw;
+  const bool mono = options_.sensor == Sensor::kMonocular;
+  // The prediction is several frames old: the motion model's wider window from the start.
+  const float radius = 2.f * (mono ? 15.f : 7.f);
+  std::fill(frame.points.begin(), frame.points.end(), nullptr);
+  const int matches = matchByProjection(frame, last, radius, mono);
+  if (matches < 20) {
+    spdlog::debug("frame {}: prediction from frame {} found {} matches", frame.index, last.index,
+                  matches);
+    std::fill(frame.points.begin(), frame.points.end(), nullptr);
+    frame.T_cw.reset();
+    return false;
+  }
+  optimizeFramePose(frame);
+  const int inliers = discardOutliers(frame);
+  spdlog::debug("frame {}: prediction from frame {}: {} matches, {} inliers", frame.index,
+                last.index, matches, inliers);
+  if (inliers >= options_.min_inliers_motion) return true;
+  frame.T_cw.reset();
+  return false;
 }
 
 bool Tracker::trackReferenceKeyFrame(Frame& frame) {

@@ -39,6 +39,13 @@ struct TrackerOptions {
   // 200 iterations): without it a lost client took up to 0.8 s per frame, fell seconds behind a
   // live camera and never caught up (7-Scenes behind an LTE link: end-to-end median 1.75 s).
   double relocalization_budget_ms = 25.0;
+  // After tracking fails, for this many frames the camera is assumed to keep the velocity it had,
+  // and each frame first searches the last tracked frame's points around that prediction (before
+  // relocalisation). A thin stretch of map (people walking through the view, the edge's points
+  // still on their way) then costs a few frames instead of the rest of the run: the client's map
+  // window holds only the keyframes near the camera, so relocalisation finds nothing once the
+  // camera has moved on. 0 = off.
+  std::size_t recover_within_frames = 30;
   // Monocular: each new keyframe triangulates new points with its best covisible keyframes right
   // away, so that tracking has fresh points before any mapper's come back (edge mode, where the
   // edge's points arrive a link round trip later). Local mode leaves it to local mapping.
@@ -91,6 +98,8 @@ class Tracker {
   // Keyframes in the relocalisation database (0 without a vocabulary).
   std::size_t placesSize() const;
   std::size_t relocalizations() const { return relocalizations_; }
+  // Times tracking came back by the motion prediction (TrackerOptions::recover_within_frames).
+  std::size_t recoveries() const { return recoveries_; }
   std::size_t resets() const { return resets_; }
   const KeyFrameTriangulationStats& triangulationStats() const { return triangulation_; }
 
@@ -99,6 +108,8 @@ class Tracker {
   bool initializeRgbd(Frame& frame);
   bool trackWithMotionModel(Frame& frame);
   bool trackReferenceKeyFrame(Frame& frame);
+  bool trackByPrediction(Frame& frame);
+  bool canRecoverByPrediction(std::size_t frame_index) const;
   bool relocalize(Frame& frame);
   std::vector<KeyFrame*> relocalizationCandidates(const Frame& frame);
   int matchForRelocalization(KeyFrame& candidate, Frame& frame);
@@ -130,6 +141,7 @@ class Tracker {
   std::vector<MapPoint*> local_points_;
   std::vector<FrameRecord> records_;
   std::size_t relocalizations_ = 0;
+  std::size_t recoveries_ = 0;
   std::size_t resets_ = 0;
   std::size_t frames_lost_ = 0;
   KeyFrameTriangulationStats triangulation_;

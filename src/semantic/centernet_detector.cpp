@@ -34,6 +34,9 @@ Letterbox letterbox(const cv::Mat& bgr, int size) {
   return out;
 }
 
+// A box within this many pixels of the image's left or right edge counts as cut off by it.
+constexpr double kBorderSlackPx = 2.0;
+
 float boxIou(const cv::Rect2f& a, const cv::Rect2f& b) {
   const float intersection = (a & b).area();
   const float united = a.area() + b.area() - intersection;
@@ -97,6 +100,7 @@ std::vector<Detection> CenterNetDetector::detect(const cv::Mat& image,
   const cv::Rect2f image_rect(0.0f, 0.0f, static_cast<float>(bgr.cols),
                               static_cast<float>(bgr.rows));
   const cv::Mat kernel = cv::Mat::ones(3, 3, CV_8U);
+  const float min_score = std::min(options.score_threshold, options.border_score_threshold);
 
   std::vector<Detection> detections;
   cv::Mat1f local_max;
@@ -104,17 +108,21 @@ std::vector<Detection> CenterNetDetector::detect(const cv::Mat& image,
     const cv::Mat1f scores = plane(*heat, class_id);
     double best = 0.0;
     cv::minMaxLoc(scores, nullptr, &best);
-    if (best < options.score_threshold) continue;
+    if (best < min_score) continue;
     cv::dilate(scores, local_max, kernel);
     for (int y = 0; y < grid; ++y) {
       for (int x = 0; x < grid; ++x) {
         const float score = scores(y, x);
-        if (score < options.score_threshold || score < local_max(y, x)) continue;
+        if (score < min_score || score < local_max(y, x)) continue;
         const double cx = x * kStride, cy = y * kStride;  // grid point in input pixels
         const double x0 = (cx - left(y, x) - box_input.offset.x) / box_input.scale;
         const double y0 = (cy - top(y, x) - box_input.offset.y) / box_input.scale;
         const double x1 = (cx + right(y, x) - box_input.offset.x) / box_input.scale;
         const double y1 = (cy + bottom(y, x) - box_input.offset.y) / box_input.scale;
+        const bool at_border = x0 <= kBorderSlackPx || x1 >= bgr.cols - 1 - kBorderSlackPx;
+        if (score < (at_border ? options.border_score_threshold : options.score_threshold)) {
+          continue;
+        }
         const cv::Rect2f box =
             cv::Rect2f(cv::Point2f(static_cast<float>(x0), static_cast<float>(y0)),
                        cv::Point2f(static_cast<float>(x1), static_cast<float>(y1))) &

@@ -45,6 +45,8 @@ CenterNetSelfieSegmenter::CenterNetSelfieSegmenter(const SegmenterOptions& optio
   }
   setNmsThreshold(options.nms_threshold);
   setScoreThreshold(options.score_threshold);
+  checkThreshold(options.border_score_threshold, "border score threshold");
+  detector_options_.border_score_threshold = options.border_score_threshold;
   detector_options_.classes = options.classes.empty() ? defaultMovableClasses() : options.classes;
   if (options.detector_input_size < 64 || options.detector_input_size % 32 != 0) {
     throw std::invalid_argument("detector input size must be a multiple of 32 from 64, got " +

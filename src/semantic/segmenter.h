@@ -22,7 +22,10 @@ struct SegmenterOptions {
   // Empty: the backend's default file name inside model_dir.
   std::filesystem::path detector_model;
   std::filesystem::path person_mask_model;
-  float score_threshold = 0.3f;    // detections below are dropped
+  float score_threshold = 0.3f;  // detections below are dropped
+  // The same for detections whose box reaches the image's edge (people walking into view score
+  // lower while only part of them shows).
+  float border_score_threshold = 0.2f;
   float nms_threshold = 0.8f;      // box IoU above which the weaker same-class box is dropped (nm)
   std::vector<int> classes;        // COCO ids to segment; empty = defaultMovableClasses()
   float mask_threshold = 0.5f;     // person probability above which a pixel is in the mask

@@ -1,6 +1,7 @@
 // Kidnapping: the camera is blinded for a while (featureless frames) and comes back elsewhere on
 // its path (RGB-D: ahead, where the map barely reaches; monocular: back to a mapped place);
-// tracking must find itself again in the same map, by bag of words.
+// tracking must find itself again in the same map, by bag of words. A short dropout, after which
+// the camera is where its motion has taken it, is bridged by the motion prediction instead.
 #include <gtest/gtest.h>
 
 #include "eval/ate.h"
@@ -32,12 +33,14 @@ struct KidnapOutcome {
   std::size_t frames_to_recover = 0;
   bool recovered = false;
   std::size_t relocalizations = 0;
+  std::size_t recoveries = 0;  // by the motion prediction
   std::size_t resets = 0;
   double ate_after_return_m = 0.0;
 };
 
-// Frames [0, 150), then 20 blank frames, then the camera returns at frame `return_at`.
-KidnapOutcome kidnap(Sensor sensor, std::size_t return_at) {
+// Frames [0, 150), then `blank_frames` blank frames, then the camera returns at frame
+// `return_at`.
+KidnapOutcome kidnap(Sensor sensor, std::size_t return_at, int blank_frames = 20) {
   auto reader = openDataset(test::sharedPath(kSequence));
   SlamOptions options = defaultSlamOptions(reader->camera(), sensor);
   options.threaded_mapping = false;
@@ -54,7 +57,7 @@ KidnapOutcome kidnap(Sensor sensor, std::size_t return_at) {
   const cv::Mat blank(first.gray.size(), first.gray.type(), cv::Scalar(128));
   const cv::Mat no_depth =
       first.depth.empty() ? cv::Mat() : cv::Mat::zeros(first.depth.size(), first.depth.type());
-  for (int k = 0; k < 20; ++k, ++index, t += 1.0 / 30) {
+  for (int k = 0; k < blank_frames; ++k, ++index, t += 1.0 / 30) {
     const TrackResult r = slam.process(index, t, blank, no_depth);
     EXPECT_NE(r.state, TrackingState::kOk) << "tracked a blank frame";
   }
@@ -72,6 +75,7 @@ KidnapOutcome kidnap(Sensor sensor, std::size_t return_at) {
   }
   slam.finish();
   out.relocalizations = slam.relocalizations();
+  out.recoveries = slam.trackingRecoveries();
   out.resets = slam.mapResets();
   // The poses after the return must agree with the ground truth of the whole run's frame.
   Trajectory before_gt;
@@ -102,6 +106,18 @@ TEST(Relocalization, RgbdFindsItselfAfterBeingBlindedAndMoved) {
 TEST(Relocalization, MonocularFindsItselfAfterBeingBlindedAndBroughtBack) {
   EDGESLAM_REQUIRE_SHARED(kSequence);
   expectRecovered(kidnap(Sensor::kMonocular, 100), 0.10);
+}
+
+TEST(Relocalization, MonocularBridgesAShortDropoutByItsMotionPrediction) {
+  EDGESLAM_REQUIRE_SHARED(kSequence);
+  // Four frames lost (150-153 blank), then the camera is where it would have been.
+  const KidnapOutcome r = kidnap(Sensor::kMonocular, 154, 4);
+  EXPECT_TRUE(r.recovered);
+  EXPECT_LE(r.frames_to_recover, 1u);
+  EXPECT_EQ(r.recoveries, 1u);
+  EXPECT_EQ(r.relocalizations, 0u);
+  EXPECT_EQ(r.resets, 0u);
+  EXPECT_LT(r.ate_after_return_m, 0.10);
 }
 
 }  // namespace
