@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 
@@ -24,10 +25,16 @@ EdgeMapSession::EdgeMapSession(const PinholeCamera& camera, Sensor sensor,
   options.mapper.monocular = sensor == Sensor::kMonocular;
   // The session's vocabulary serves the mapper's bag-of-words triangulation search too.
   if (!options.mapper.vocabulary) options.mapper.vocabulary = options.vocabulary;
+  const int mapping_nice =
+      options.segmenter != nullptr
+          ? std::max(options.mapper.thread_nice, options.mapping_nice_when_segmenting)
+          : options.mapper.thread_nice;
+  options.mapper.thread_nice = mapping_nice;
   mapper_ = std::make_unique<LocalMapper>(map_, camera_, options.mapper);
   if (options.vocabulary != nullptr && options.loop_closing) {
     LoopCloserOptions loop = loopCloserOptionsFor(sensor);
     loop.threaded = threaded_;
+    loop.thread_nice = std::max(loop.thread_nice, mapping_nice);
     loop_closer_ =
         std::make_unique<LoopCloser>(map_, camera_, options.vocabulary, loop, mapper_.get());
     loop_closer_->setMapCorrectedCallback([this] { publishSlice(nullptr); });
