@@ -115,9 +115,11 @@ void runSegment(const SegmentOptions& o) {
   options.border_score_threshold = o.border_score;
   options.detector_input_size = o.input_size;
   const auto segmenter = makeSegmenter(options);
-  fmt::print("segmenter {} (models {}), classes {}, nm {:.2f}, score {:.2f} ({:.2f} at the edge)\n",
-             segmenter->backendName(), options.model_dir.string(),
-             classListToString(options.classes), o.nm, o.score, o.border_score);
+  fmt::print(
+      "segmenter {} (models {}), classes {}, nm {:.2f}, score {:.2f} ({:.2f} at the image's "
+      "sides)\n",
+      segmenter->backendName(), options.model_dir.string(), classListToString(options.classes),
+      o.nm, o.score, o.border_score);
   if (!o.truth.empty()) {
     scoreSegmenterOnSequence(*segmenter, o.truth, {o.every, o.reduce});
     return;
@@ -171,8 +173,8 @@ void addSegmentCommand(CLI::App& app) {
       ->capture_default_str();
   segment
       ->add_option("--border-score", options->border_score,
-                   "Detection score threshold for boxes that reach the image's edge (people "
-                   "walking into view score lower)")
+                   "Detection score threshold for boxes that reach the image's left or right "
+                   "edge (people walking into view score lower)")
       ->check(CLI::Range(0.0f, 1.0f))
       ->capture_default_str();
   segment

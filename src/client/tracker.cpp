@@ -98,7 +98,8 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
       ok = velocity_ && trackWithMotionModel(frame);
       if (!ok) ok = trackReferenceKeyFrame(frame);
     } else {
-      if (canRecoverByPrediction(frame_index) && trackByPrediction(frame)) {
+      if (canRecoverByPrediction(frame_index) &&
+          trackWithMotionModel(frame, frame_index - last_frame_->index)) {
         ok = true;
         recovered = true;
       } else {
@@ -267,57 +268,39 @@ int Tracker::discardOutliers(Frame& frame) {
   return inliers;
 }
 
-bool Tracker::trackWithMotionModel(Frame& frame) {
+bool Tracker::trackWithMotionModel(Frame& frame, std::size_t steps) {
   const Frame& last = *last_frame_;
-  frame.T_cw = *velocity_ * *last.T_cw;
+  SE3d since_last;
+  for (std::size_t i = 0; i < steps; ++i) since_last = *velocity_ * since_last;
+  frame.T_cw = since_last * *last.T_cw;
   const bool mono = options_.sensor == Sensor::kMonocular;
   const float radius = mono ? 15.f : 7.f;
-  std::fill(frame.points.begin(), frame.points.end(), nullptr);
-  int matches = matchByProjection(frame, last, radius, mono);
-  if (matches < 20) {
+  // A prediction across lost frames is less sure: the wider window from the start.
+  int matches = 0;
+  for (float r = steps == 1 ? radius : 2.f * radius; r <= 2.f * radius; r *= 2.f) {
     std::fill(frame.points.begin(), frame.points.end(), nullptr);
-    matches = matchByProjection(frame, last, 2.f * radius, mono);
+    matches = matchByProjection(frame, last, r, mono);
+    if (matches >= 20) break;
   }
-  if (matches < 20) {
-    spdlog::debug("frame {}: motion model found {} matches", frame.index, matches);
-    return false;
+  if (matches >= 20) {
+    optimizeFramePose(frame);
+    const int inliers = discardOutliers(frame);
+    spdlog::debug("frame {}: motion model over {} frames: {} matches, {} inliers", frame.index,
+                  steps, matches, inliers);
+    if (inliers >= options_.min_inliers_motion) return true;
+  } else {
+    spdlog::debug("frame {}: motion model over {} frames found {} matches", frame.index, steps,
+                  matches);
   }
-  optimizeFramePose(frame);
-  const int inliers = discardOutliers(frame);
-  spdlog::debug("frame {}: motion model {} matches, {} inliers", frame.index, matches, inliers);
-  return inliers >= options_.min_inliers_motion;
+  std::fill(frame.points.begin(), frame.points.end(), nullptr);
+  frame.T_cw.reset();
+  return false;
 }
 
 bool Tracker::canRecoverByPrediction(std::size_t frame_index) const {
   return options_.recover_within_frames > 0 && velocity_ && last_frame_ && last_frame_->T_cw &&
          frame_index > last_frame_->index &&
          frame_index - last_frame_->index <= options_.recover_within_frames;
-}
-
-bool Tracker::trackByPrediction(Frame& frame) {
-  const Frame& last = *last_frame_;
-  SE3d since_last;
-  for (std::size_t i = last.index; i < frame.index; ++i) since_last = *velocity_ * since_last;
-  frame.T_cw = since_last * *last.T_cw;
-  const bool mono = options_.sensor == Sensor::kMonocular;
-  // The prediction is several frames old: the motion model's wider window from the start.
-  const float radius = 2.f * (mono ? 15.f : 7.f);
-  std::fill(frame.points.begin(), frame.points.end(), nullptr);
-  const int matches = matchByProjection(frame, last, radius, mono);
-  if (matches < 20) {
-    spdlog::debug("frame {}: prediction from frame {} found {} matches", frame.index, last.index,
-                  matches);
-    std::fill(frame.points.begin(), frame.points.end(), nullptr);
-    frame.T_cw.reset();
-    return false;
-  }
-  optimizeFramePose(frame);
-  const int inliers = discardOutliers(frame);
-  spdlog::debug("frame {}: prediction from frame {}: {} matches, {} inliers", frame.index,
-                last.index, matches, inliers);
-  if (inliers >= options_.min_inliers_motion) return true;
-  frame.T_cw.reset();
-  return false;
 }
 
 bool Tracker::trackReferenceKeyFrame(Frame& frame) {

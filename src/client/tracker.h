@@ -106,9 +106,10 @@ class Tracker {
  private:
   bool initialize(Frame& frame);
   bool initializeRgbd(Frame& frame);
-  bool trackWithMotionModel(Frame& frame);
+  // The last tracked frame's points projected from the pose its velocity predicts `steps`
+  // frames on (more than one: across lost frames).
+  bool trackWithMotionModel(Frame& frame, std::size_t steps = 1);
   bool trackReferenceKeyFrame(Frame& frame);
-  bool trackByPrediction(Frame& frame);
   bool canRecoverByPrediction(std::size_t frame_index) const;
   bool relocalize(Frame& frame);
   std::vector<KeyFrame*> relocalizationCandidates(const Frame& frame);
