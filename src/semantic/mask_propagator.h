@@ -21,6 +21,11 @@ struct MaskPropagatorOptions {
   // first carried to a frame some way past its keyframe), up to max_search_radius_px.
   float search_radius_per_frame_px = 8.f;
   float max_search_radius_px = 96.f;
+  // How much an instance's apparent size may change per frame (someone walking at 1.4 m/s, 1.5 m
+  // from the camera: ~3 %). Bounds the constant-velocity prediction, which would otherwise
+  // compound a growth rate over every frame without matches (a mask grew to the whole image in
+  // six frames and tracking was lost), and the similarities fitted against that prediction.
+  double max_scale_change_per_frame = 1.08;
 };
 
 class MaskPropagator {

@@ -62,8 +62,15 @@ TransferredInstance fitMotion(const std::vector<cv::Point2f>& from,
     if (!warp.empty()) {
       const int inliers = cv::countNonZero(inlier_flags);
       const double scale = std::hypot(warp.at<double>(0, 0), warp.at<double>(1, 0));
-      const bool plausible_scale =
+      bool plausible_scale =
           scale <= options.max_scale_change && scale * options.max_scale_change >= 1.0;
+      if (fallback.motion == InstanceMotion::kPredicted &&
+          options.max_scale_change_from_prediction > 0.0) {
+        const double ratio =
+            scale / std::max(1e-6, std::hypot(fallback.warp(0, 0), fallback.warp(1, 0)));
+        plausible_scale = plausible_scale && ratio <= options.max_scale_change_from_prediction &&
+                          ratio * options.max_scale_change_from_prediction >= 1.0;
+      }
       if (plausible_scale && inliers >= 3 &&
           inliers >= options.min_inlier_ratio * static_cast<double>(from.size())) {
         fit.motion = InstanceMotion::kSimilarity;
@@ -98,30 +105,82 @@ TransferredInstance fitMotion(const std::vector<cv::Point2f>& from,
   return fit;
 }
 
+// How far an instance cut by the keyframe's image edge grows back out past that edge: as far as
+// the warp brings the edge into the frame (in keyframe pixels), on each side it touches.
+struct EdgeGrowth {
+  int left = 0, top = 0, right = 0, bottom = 0;
+  bool any() const { return left + top + right + bottom > 0; }
+};
+
+cv::Point2d warped(const cv::Matx23d& w, double x, double y) {
+  return {w(0, 0) * x + w(0, 1) * y + w(0, 2), w(1, 0) * x + w(1, 1) * y + w(1, 2)};
+}
+
+EdgeGrowth growthPastCutEdges(const cv::Rect& box, const cv::Size& image, const cv::Matx23d& warp) {
+  EdgeGrowth growth;
+  const double scale = std::max(1e-3, std::hypot(warp(0, 0), warp(1, 0)));
+  // Never more than the image: a wild warp must not paint a runaway strip.
+  const auto pixels = [&](double inward, int limit) {
+    return inward <= 0.0 ? 0 : std::min(limit, static_cast<int>(std::ceil(inward / scale)));
+  };
+  // A mask resampled from the edge's reduced resolution may stop a pixel or two short of the edge.
+  constexpr int kCutTolerancePx = 2;
+  const double top = box.y, bottom = box.br().y, left = box.x, right = box.br().x;
+  if (box.x <= kCutTolerancePx) {
+    growth.left =
+        pixels(std::min(warped(warp, left, top).x, warped(warp, left, bottom).x), image.width);
+  }
+  if (box.br().x >= image.width - kCutTolerancePx) {
+    const double w = image.width;
+    growth.right = pixels(w - std::max(warped(warp, right, top).x, warped(warp, right, bottom).x),
+                          image.width);
+  }
+  if (box.y <= kCutTolerancePx) {
+    growth.top =
+        pixels(std::min(warped(warp, left, top).y, warped(warp, right, top).y), image.height);
+  }
+  if (box.br().y >= image.height - kCutTolerancePx) {
+    const double h = image.height;
+    growth.bottom = pixels(
+        h - std::max(warped(warp, left, bottom).y, warped(warp, right, bottom).y), image.height);
+  }
+  return growth;
+}
+
 // Paints the pixels of `label` inside `source_box` of `source`, moved by `warp`, into `target`.
+// With `grow_cut_edges`, an instance cut by the image edge that the warp moves inwards has its
+// pixels on the cut repeated outwards first: the part of a person that was out of the keyframe's
+// view comes in with them (someone walking in from the side is masked whole, not as the sliver
+// the keyframe saw).
 void paintWarped(const cv::Mat1b& source, std::uint8_t label, const cv::Rect& source_box,
-                 const cv::Matx23d& warp, cv::Mat1b& target) {
+                 const cv::Matx23d& warp, bool grow_cut_edges, cv::Mat1b& target) {
+  cv::Mat1b instance = source(source_box) == label;
+  cv::Rect box = source_box;
+  if (grow_cut_edges) {
+    const EdgeGrowth g = growthPastCutEdges(source_box, source.size(), warp);
+    if (g.any()) {
+      cv::copyMakeBorder(instance, instance, g.top, g.bottom, g.left, g.right,
+                         cv::BORDER_REPLICATE);
+      box = cv::Rect(box.x - g.left, box.y - g.top, box.width + g.left + g.right,
+                     box.height + g.top + g.bottom);
+    }
+  }
   std::array<cv::Point2f, 4> corners;
   const std::array<cv::Point2d, 4> box_corners = {
-      cv::Point2d(source_box.x, source_box.y), cv::Point2d(source_box.br().x, source_box.y),
-      cv::Point2d(source_box.x, source_box.br().y),
-      cv::Point2d(source_box.br().x, source_box.br().y)};
+      cv::Point2d(box.x, box.y), cv::Point2d(box.br().x, box.y), cv::Point2d(box.x, box.br().y),
+      cv::Point2d(box.br().x, box.br().y)};
   for (std::size_t i = 0; i < 4; ++i) {
-    const cv::Point2d& c = box_corners[i];
-    corners[i] = cv::Point2f(static_cast<float>(warp(0, 0) * c.x + warp(0, 1) * c.y + warp(0, 2)),
-                             static_cast<float>(warp(1, 0) * c.x + warp(1, 1) * c.y + warp(1, 2)));
+    const cv::Point2d c = warped(warp, box_corners[i].x, box_corners[i].y);
+    corners[i] = cv::Point2f(static_cast<float>(c.x), static_cast<float>(c.y));
   }
   const cv::Rect target_box =
       cv::boundingRect(std::vector<cv::Point2f>(corners.begin(), corners.end())) &
       cv::Rect(0, 0, target.cols, target.rows);
   if (target_box.empty()) return;
-  cv::Mat1b instance = source(source_box) == label;
-  // Maps source-box pixels to target-box pixels: shift into the image, warp, shift into the box.
+  // Maps box pixels to target-box pixels: shift into the image, warp, shift into the box.
   const cv::Matx23d local(
-      warp(0, 0), warp(0, 1),
-      warp(0, 0) * source_box.x + warp(0, 1) * source_box.y + warp(0, 2) - target_box.x, warp(1, 0),
-      warp(1, 1),
-      warp(1, 0) * source_box.x + warp(1, 1) * source_box.y + warp(1, 2) - target_box.y);
+      warp(0, 0), warp(0, 1), warp(0, 0) * box.x + warp(0, 1) * box.y + warp(0, 2) - target_box.x,
+      warp(1, 0), warp(1, 1), warp(1, 0) * box.x + warp(1, 1) * box.y + warp(1, 2) - target_box.y);
   cv::Mat1b moved;
   cv::warpAffine(instance, moved, local, target_box.size(), cv::INTER_NEAREST, cv::BORDER_CONSTANT,
                  cv::Scalar(0));
@@ -247,7 +306,8 @@ MaskTransferResult transferLabels(const PreparedLabels& prepared,
     }
     TransferredInstance moved = fitMotion(from, to, options, fallback);
     moved.label = static_cast<std::uint8_t>(label);
-    paintWarped(keyframe_labels, moved.label, box, moved.warp, result.labels);
+    paintWarped(keyframe_labels, moved.label, box, moved.warp, options.grow_cut_edges,
+                result.labels);
     result.instances.push_back(moved);
   }
   std::reverse(result.instances.begin(), result.instances.end());

@@ -35,8 +35,15 @@ struct MaskTransferOptions {
   double ransac_threshold_px = 3.0;
   double min_inlier_ratio = 0.5;  // of the matches used for the similarity
   double max_scale_change = 2.5;  // similarities scaling by more (or less than 1/this) are rejected
+  // Where an instance has a predicted motion, a similarity whose scale differs from the
+  // prediction's by more than this factor (or less than its inverse) is rejected too: a fit on
+  // the last few matches of someone walking out of view can claim any size (0 = unchecked).
+  double max_scale_change_from_prediction = 0.0;
   int ransac_iterations = 100;
   int merge_gap_px = 4;  // transferMask: mask fragments closer than this move as one instance
+  // An instance cut by the keyframe's image edge grows back out past it as its motion brings
+  // that edge into view (its pixels on the cut repeated outwards).
+  bool grow_cut_edges = true;
 };
 
 enum class InstanceMotion { kSimilarity, kTranslation, kPredicted, kBackground, kIdentity };

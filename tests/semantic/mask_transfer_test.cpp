@@ -129,6 +129,32 @@ TEST(MaskTransfer, InstancesMovedOutOfTheImageDisappear) {
   EXPECT_EQ(cv::countNonZero(result.labels), 0);
 }
 
+TEST(MaskTransfer, APersonCutByTheImageEdgeComesInWhole) {
+  // The keyframe sees 30 px of someone walking in from the left; 40 px later the mask must cover
+  // what entered behind them, not only the sliver moved inwards. Walking out to the right edge
+  // brings nothing in, and growing can be switched off.
+  cv::Mat1b labels = cv::Mat1b::zeros(480, 640);
+  labels(cv::Rect(0, 100, 30, 300)).setTo(1);
+  labels(cv::Rect(600, 120, 40, 200)).setTo(2);
+  std::vector<cv::Point2f> from, to;
+  for (int y = 110; y < 390; y += 20) {
+    from.emplace_back(10.f + static_cast<float>(y % 3), static_cast<float>(y));
+    to.push_back(from.back() + cv::Point2f(40.f, 0.f));
+    from.emplace_back(615.f + static_cast<float>(y % 5), static_cast<float>(y));
+    to.push_back(from.back() + cv::Point2f(10.f, 0.f));
+  }
+  const MaskTransferResult grown = transferLabels(labels, from, to);
+  EXPECT_EQ(cv::countNonZero(grown.labels == 1), 70 * 300);
+  EXPECT_EQ(cv::countNonZero(grown.labels(cv::Rect(0, 100, 70, 300)) == 1), 70 * 300);
+  EXPECT_EQ(cv::countNonZero(grown.labels == 2), 30 * 200);
+
+  MaskTransferOptions options;
+  options.grow_cut_edges = false;
+  const MaskTransferResult sliver = transferLabels(labels, from, to, options);
+  EXPECT_EQ(cv::countNonZero(sliver.labels == 1), 30 * 300);
+  EXPECT_EQ(cv::countNonZero(sliver.labels(cv::Rect(40, 100, 30, 300)) == 1), 30 * 300);
+}
+
 TEST(MaskTransfer, TooFewOrDisagreeingMatchesFallBackToThePredictedMotion) {
   // A person walking behind something keeps two stray matches: they must not throw the mask
   // across the image; the instance goes on with the motion its caller predicts.
