@@ -199,7 +199,9 @@ int runPipeline(const RunOptions& options) {
   }
   slam_options.semantic = options.semantic;
   slam_options.keyframe_image_reduce = options.segment_reduce;
-  slam_options.segmentation_refresh_frames = options.segment_refresh;
+  slam_options.segmentation_refresh.max_frames = options.segment_refresh;
+  slam_options.segmentation_refresh.min_frames = options.segment_refresh_min.value_or(
+      std::min(slam_options.segmentation_refresh.min_frames, options.segment_refresh));
   if (options.semantic && options.server_address.empty()) {
     // The segmenter runs on its own thread beside tracking (and, embedded, beside the edge's
     // mapping) in this process; OpenCV's default pool would spread each inference over every
@@ -479,6 +481,12 @@ void addRunOptions(CLI::App* run, const std::shared_ptr<RunOptions>& options) {
                   "(0 = keyframes by the usual rules only)")
       ->check(CLI::Range(0, 1000))
       ->capture_default_str();
+  run->add_option("--segment-refresh-min", options->segment_refresh_min,
+                  "The refresh interval shortens to 4x the masks' delay in frames, down to N "
+                  "(default: " +
+                      std::to_string(SegmentationRefreshOptions{}.min_frames) +
+                      "; equal to --segment-refresh: a fixed interval)")
+      ->check(CLI::Range(1, 1000));
   run->add_option("--recover-frames", options->recover_frames,
                   "After tracking fails, for up to N frames the camera is assumed to keep its "
                   "velocity and is searched for there before relocalisation (0 = off)")

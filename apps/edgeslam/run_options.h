@@ -21,7 +21,9 @@ struct RunOptions {
   std::filesystem::path models_dir;  // segmentation models; "" = the shared models folder
   int segment_input = 256;           // detector input side
   int segment_reduce = 2;            // keyframes are segmented at 1/this of full size
-  int segment_refresh = SlamOptions{}.segmentation_refresh_frames;  // 0 = no refresh keyframes
+  // Refresh keyframes for segmentation at most / at least this many frames apart (0 = none).
+  int segment_refresh = SegmentationRefreshOptions{}.max_frames;
+  std::optional<int> segment_refresh_min;  // default: SegmentationRefreshOptions, or the most
   // Lost frames bridged by the motion prediction (TrackerOptions::recover_within_frames).
   std::size_t recover_frames = TrackerOptions{}.recover_within_frames;
   std::size_t max_frames = 0;  // 0 = all

@@ -3,7 +3,9 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <stdexcept>
+#include <vector>
 
 #include "semantic/feature_subset.h"
 #include "semantic/mask_query.h"
@@ -28,7 +30,9 @@ void SemanticFrameFilter::offerMask(std::size_t frame_index, cv::Mat1b labels) {
     for (const auto& entry : history_) {
       if (entry.first >= frame_index) since.push_back(entry);
     }
-    if (since.empty() || since.front().first != frame_index) {
+    const bool too_old = since.empty() || since.front().first != frame_index;
+    noteDelay(too_old ? options_.history_frames : since.back().first - frame_index);
+    if (too_old) {
       ++counters_.masks_too_old;
       spdlog::debug("mask of frame {} arrived past the history", frame_index);
       return;
@@ -98,6 +102,24 @@ SemanticFrame SemanticFrameFilter::filter(std::size_t frame_index,
   counters_.frames_with_mask += !out.mask.empty();
   counters_.features_culled += static_cast<std::size_t>(out.culled);
   return out;
+}
+
+void SemanticFrameFilter::noteDelay(std::size_t frames) {
+  constexpr std::size_t kRecentMasks = 5;
+  recent_delays_.push_back(frames);
+  while (recent_delays_.size() > kRecentMasks) recent_delays_.pop_front();
+}
+
+std::optional<std::size_t> SemanticFrameFilter::typicalMaskDelayFrames() const {
+  std::vector<std::size_t> delays;
+  {
+    std::lock_guard lock(mutex_);
+    delays.assign(recent_delays_.begin(), recent_delays_.end());
+  }
+  if (delays.empty()) return std::nullopt;
+  const auto middle = delays.begin() + static_cast<std::ptrdiff_t>(delays.size() / 2);
+  std::nth_element(delays.begin(), middle, delays.end());
+  return *middle;
 }
 
 SemanticFilterCounters SemanticFrameFilter::counters() const {

@@ -59,6 +59,10 @@ class SemanticFrameFilter {
 
   SemanticFilterCounters counters() const;
 
+  // The median of how many frames after their keyframe the last few masks arrived (nullopt
+  // before the first).
+  std::optional<std::size_t> typicalMaskDelayFrames() const;
+
  private:
   // A keyframe mask carried forward to `frame` by its own propagator.
   struct CarriedMask {
@@ -69,6 +73,7 @@ class SemanticFrameFilter {
   using History = std::deque<std::pair<std::size_t, std::shared_ptr<const FrameFeatures>>>;
 
   void takeCarriedMask();
+  void noteDelay(std::size_t frames);  // with mutex_ held
 
   PinholeCamera camera_;
   SemanticFilterOptions options_;
@@ -82,6 +87,7 @@ class SemanticFrameFilter {
   History history_;
   std::optional<CarriedMask> carried_;
   SemanticFilterCounters counters_;
+  std::deque<std::size_t> recent_delays_;
 };
 
 }  // namespace edgeslam

@@ -33,13 +33,16 @@ TrackingSlam::TrackingSlam(const PinholeCamera& camera, SlamOptions options,
   options_.mapper.monocular = options_.sensor == Sensor::kMonocular;
   if (options_.semantic) {
     semantic_filter_ = std::make_unique<SemanticFrameFilter>(camera_, options_.semantic_filter);
+    validate(options_.segmentation_refresh);
     const double fps = camera_.intrinsics().fps;
     const double rate = fps > 0 ? std::min(1.0, fps / 30.0) : 1.0;
+    const auto scaled = [rate](int frames) {
+      return frames <= 0 ? 0 : std::max(1, static_cast<int>(std::lround(frames * rate)));
+    };
+    options_.segmentation_refresh.min_frames = scaled(options_.segmentation_refresh.min_frames);
+    options_.segmentation_refresh.max_frames = scaled(options_.segmentation_refresh.max_frames);
     options_.tracker.keyframes.segmentation_refresh =
-        options_.segmentation_refresh_frames <= 0
-            ? 0
-            : std::max(1,
-                       static_cast<int>(std::lround(options_.segmentation_refresh_frames * rate)));
+        segmentationRefreshFrames(options_.segmentation_refresh, std::nullopt);
   }
 }
 
@@ -62,6 +65,10 @@ TrackResult TrackingSlam::process(std::size_t frame_index, double timestamp, con
   }
   last_stages_.features_ms = stage.elapsedMs();
   features_ms_.add(last_stages_.features_ms);
+  if (semantic_filter_) {
+    tracker_->keyframeParameters().segmentation_refresh = segmentationRefreshFrames(
+        options_.segmentation_refresh, semantic_filter_->typicalMaskDelayFrames());
+  }
   const cv::Mat& image = color.empty() ? gray : color;
   beforeTracking(frame_index, image);
   stage = Stopwatch();

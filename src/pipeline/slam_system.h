@@ -6,6 +6,7 @@
 #include <memory>
 #include <opencv2/core.hpp>
 
+#include "client/segmentation_refresh.h"
 #include "client/semantic_frame_filter.h"
 #include "client/tracker.h"
 #include "edge/local_mapper.h"
@@ -48,9 +49,10 @@ struct SlamOptions {
   SemanticFilterOptions semantic_filter;
   std::shared_ptr<Segmenter> segmenter;  // local mode
   int keyframe_image_reduce = 2;         // keyframes are segmented at 1/this of full size
-  // With semantic culling: at most this many frames (of a 30 fps camera) between keyframes, so
-  // that people walking into view are segmented soon (KeyFrameParameters::segmentation_refresh).
-  int segmentation_refresh_frames = 12;
+  // With semantic culling: how many frames (of a 30 fps camera) at most between keyframes, so
+  // that people walking into view are segmented soon; the interval follows the masks' delay
+  // (client/segmentation_refresh.h, KeyFrameParameters::segmentation_refresh).
+  SegmentationRefreshOptions segmentation_refresh;
 };
 
 // Nice 10 gives a thread about a tenth of the CPU against a nice-0 one.

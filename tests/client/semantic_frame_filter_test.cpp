@@ -101,5 +101,22 @@ TEST(SemanticFrameFilter, RefusesMisSizedMasksAndCountsMasksPastTheHistory) {
   EXPECT_TRUE(filter.filter(10, lattice({}, {}, {})).mask.empty());
 }
 
+TEST(SemanticFrameFilter, TypicalMaskDelayIsTheMedianOfTheLastFive) {
+  SemanticFrameFilter filter(test::syntheticCamera());
+  EXPECT_EQ(filter.typicalMaskDelayFrames(), std::nullopt);
+  const cv::Rect object(200, 150, 120, 160);
+  // Masks of keyframes 0, 10, 20, ... arriving 1, 1, 2, 6, 7 and then 3 frames late.
+  const std::size_t delays[] = {1, 1, 2, 6, 7, 3};
+  std::size_t frame_index = 0;
+  for (std::size_t k = 0; k < 6; ++k) {
+    const std::size_t keyframe = 10 * k;
+    while (frame_index <= keyframe + delays[k]) {
+      filter.filter(frame_index++, lattice(object, {}, {}));
+    }
+    filter.offerMask(keyframe, labelsWith(object));
+  }
+  EXPECT_EQ(filter.typicalMaskDelayFrames(), std::optional<std::size_t>(3));  // of 1 2 6 7 3
+}
+
 }  // namespace
 }  // namespace edgeslam
