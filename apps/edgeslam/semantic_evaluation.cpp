@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <opencv2/core.hpp>
+
 #include "synth/mask_metrics.h"
 
 namespace edgeslam::cli {
@@ -31,8 +33,13 @@ void SemanticEvaluation::addFrame(std::size_t index, const TrackResult& result,
   if (!frame->mask.empty() && !result.new_keyframe) {
     if (const auto iou = maskIoU(frame->mask, truth)) {
       iou_.add(*iou);
-      spdlog::debug("frame {}: mask of keyframe frame {} has IoU {:.3f}", index,
-                    frame->mask_source_frame.value_or(0), *iou);
+      if (spdlog::should_log(spdlog::level::debug)) {
+        spdlog::debug(
+            "frame {}: mask of keyframe frame {} has IoU {:.3f} ({} px masked, {} px of "
+            "people, {} px both)",
+            index, frame->mask_source_frame.value_or(0), *iou, cv::countNonZero(frame->mask),
+            cv::countNonZero(truth), cv::countNonZero(frame->mask & truth));
+      }
     }
   }
   features_on_people_ += countFeaturesOnMask(positions(*frame->all), truth).on_mask;
