@@ -38,6 +38,13 @@ nlohmann::json toJson(const PercentileSummary& s) {
   return {{"median", s.median}, {"p90", s.p90}, {"p99", s.p99}, {"max", s.max}};
 }
 
+nlohmann::json keyFrameDecisionsJson(const KeyFrameDecisionCounts& c) {
+  return {{"rules", c.by_rules},
+          {"forced", c.forced},
+          {"starving", c.starving},
+          {"segmentation", c.for_segmentation}};
+}
+
 std::string resolveSensor(const std::string& requested, const DatasetInfo& info) {
   if (requested == "auto") return info.has_depth ? "rgbd" : "mono";
   if (requested == "rgbd" && !info.has_depth) {
@@ -319,6 +326,7 @@ int runPipeline(const RunOptions& options) {
                             {"loops", counters.loops},
                             {"relocalizations", slam.relocalizations()},
                             {"tracking_recoveries", slam.trackingRecoveries()},
+                            {"keyframe_decisions", keyFrameDecisionsJson(slam.keyFrameDecisions())},
                             {"map_resets", slam.mapResets()},
                             {"mode", mode},
                             {"requested_mode", options.mode},

@@ -37,4 +37,23 @@ KeyFrameDecision decideKeyFrame(const KeyFrameParameters& params, const KeyFrame
   return KeyFrameDecision::kNo;
 }
 
+void KeyFrameDecisionCounts::add(KeyFrameDecision d) {
+  switch (d) {
+    case KeyFrameDecision::kNo:
+      return;
+    case KeyFrameDecision::kYes:
+      ++by_rules;
+      return;
+    case KeyFrameDecision::kYesForced:
+      ++forced;
+      return;
+    case KeyFrameDecision::kYesStarving:
+      ++starving;
+      return;
+    case KeyFrameDecision::kYesForSegmentation:
+      ++for_segmentation;
+      return;
+  }
+}
+
 }  // namespace edgeslam

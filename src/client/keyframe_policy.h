@@ -52,4 +52,14 @@ inline bool isKeyFrame(KeyFrameDecision d) {
   return d != KeyFrameDecision::kNo;
 }
 
+// How many keyframes each rule made (tells a user why a run has the keyframes it has).
+struct KeyFrameDecisionCounts {
+  std::size_t by_rules = 0;          // rules (1), (3) and (4)
+  std::size_t forced = 0;            // rule (2): the map update or the last keyframe overdue
+  std::size_t starving = 0;          // tracking starving
+  std::size_t for_segmentation = 0;  // segmentation refresh
+  void add(KeyFrameDecision d);
+  std::size_t total() const { return by_rules + forced + starving + for_segmentation; }
+};
+
 }  // namespace edgeslam

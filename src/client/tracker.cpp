@@ -138,7 +138,11 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
       if (last_frame_ && last_frame_->T_cw && last_frame_->index + 1 == frame_index) {
         velocity_ = *frame.T_cw * last_frame_->T_cw->inverse();
       }
-      if (isKeyFrame(decide(frame, inliers))) new_keyframe = createKeyFrame(frame);
+      const KeyFrameDecision decision = decide(frame, inliers);
+      if (isKeyFrame(decision)) {
+        keyframe_decisions_.add(decision);
+        new_keyframe = createKeyFrame(frame);
+      }
       result.tracked_points = inliers;
     } else {
       if (state_ == TrackingState::kOk) spdlog::warn("tracking lost at frame {}", frame_index);

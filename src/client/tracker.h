@@ -101,6 +101,8 @@ class Tracker {
   // Times tracking came back by the motion prediction (TrackerOptions::recover_within_frames).
   std::size_t recoveries() const { return recoveries_; }
   std::size_t resets() const { return resets_; }
+  // Keyframes made so far, by the rule that made them.
+  const KeyFrameDecisionCounts& keyFrameDecisions() const { return keyframe_decisions_; }
   const KeyFrameTriangulationStats& triangulationStats() const { return triangulation_; }
 
  private:
@@ -143,6 +145,7 @@ class Tracker {
   std::vector<FrameRecord> records_;
   std::size_t relocalizations_ = 0;
   std::size_t recoveries_ = 0;
+  KeyFrameDecisionCounts keyframe_decisions_;
   std::size_t resets_ = 0;
   std::size_t frames_lost_ = 0;
   KeyFrameTriangulationStats triangulation_;

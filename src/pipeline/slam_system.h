@@ -127,6 +127,8 @@ class SlamSystem {
   virtual std::size_t relocalizations() const = 0;
   // Times tracking came back by its motion prediction after a few lost frames.
   virtual std::size_t trackingRecoveries() const { return 0; }
+  // Keyframes the client's tracker made, by rule (zeros where the client does not track).
+  virtual KeyFrameDecisionCounts keyFrameDecisions() const { return {}; }
   virtual std::size_t mapResets() const = 0;
   // The last frame's semantic stage (mask, culled features); nullptr where the client does not
   // track (offload).
@@ -150,6 +152,9 @@ class TrackingSlam : public SlamSystem {
   std::size_t mapPointCount() const override;
   std::size_t relocalizations() const override { return tracker_->relocalizations(); }
   std::size_t trackingRecoveries() const override { return tracker_->recoveries(); }
+  KeyFrameDecisionCounts keyFrameDecisions() const override {
+    return tracker_->keyFrameDecisions();
+  }
   std::size_t mapResets() const override { return tracker_->resets(); }
   // Always present: without semantic culling, every feature is kept and there is no mask.
   const SemanticFrame* lastSemanticFrame() const override { return &last_semantic_; }

@@ -105,5 +105,21 @@ TEST(KeyFramePolicy, TableIRowsChangeTheDecision) {
   EXPECT_EQ(decideKeyFrame(slow_link, e), KeyFrameDecision::kNo);
 }
 
+TEST(KeyFramePolicy, DecisionCountsGoByRule) {
+  KeyFrameDecisionCounts counts;
+  for (const KeyFrameDecision d :
+       {KeyFrameDecision::kNo, KeyFrameDecision::kYes, KeyFrameDecision::kYes,
+        KeyFrameDecision::kYesForced, KeyFrameDecision::kYesStarving,
+        KeyFrameDecision::kYesForSegmentation, KeyFrameDecision::kYesForSegmentation,
+        KeyFrameDecision::kYesForSegmentation}) {
+    counts.add(d);
+  }
+  EXPECT_EQ(counts.by_rules, 2u);
+  EXPECT_EQ(counts.forced, 1u);
+  EXPECT_EQ(counts.starving, 1u);
+  EXPECT_EQ(counts.for_segmentation, 3u);
+  EXPECT_EQ(counts.total(), 7u);
+}
+
 }  // namespace
 }  // namespace edgeslam

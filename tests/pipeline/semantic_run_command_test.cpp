@@ -93,6 +93,12 @@ TEST(SemanticRunCommand, SemanticOffStillScoresTheGroundTruthButCullsNothing) {
   EXPECT_EQ(m["semantic"]["enabled"], false);
   EXPECT_TRUE(m["semantic"]["mask_iou_median"].is_null());
   EXPECT_DOUBLE_EQ(m["semantic"]["dynamic_features_kept_ratio"].get<double>(), 1.0);
+  // Without semantics no keyframe is made for segmentation; the others are counted by rule.
+  const auto& decisions = m["keyframe_decisions"];
+  EXPECT_EQ(decisions["segmentation"].get<int>(), 0);
+  EXPECT_GE(decisions["rules"].get<int>() + decisions["forced"].get<int>() +
+                decisions["starving"].get<int>(),
+            5);
 }
 
 TEST(SemanticRunCommand, MissingModelsAreAClearErrorBeforeAnyFrame) {
