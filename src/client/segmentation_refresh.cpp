@@ -24,12 +24,11 @@ int segmentationRefreshFrames(const SegmentationRefreshOptions& options,
                               std::optional<std::size_t> mask_delay_frames) {
   if (options.max_frames <= 0) return 0;
   if (!mask_delay_frames) return options.max_frames;
+  // The delay is capped first so that the product stays small.
   const std::size_t wanted =
-      std::min<std::size_t>(*mask_delay_frames, static_cast<std::size_t>(options.max_frames)) *
+      std::min(*mask_delay_frames, static_cast<std::size_t>(options.max_frames)) *
       static_cast<std::size_t>(options.duty_factor);
-  return std::clamp(
-      static_cast<int>(std::min<std::size_t>(wanted, static_cast<std::size_t>(options.max_frames))),
-      std::max(1, options.min_frames), options.max_frames);
+  return std::clamp(static_cast<int>(wanted), std::max(1, options.min_frames), options.max_frames);
 }
 
 }  // namespace edgeslam

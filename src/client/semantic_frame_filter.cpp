@@ -108,18 +108,15 @@ void SemanticFrameFilter::noteDelay(std::size_t frames) {
   constexpr std::size_t kRecentMasks = 5;
   recent_delays_.push_back(frames);
   while (recent_delays_.size() > kRecentMasks) recent_delays_.pop_front();
+  std::vector<std::size_t> delays(recent_delays_.begin(), recent_delays_.end());
+  const auto middle = delays.begin() + static_cast<std::ptrdiff_t>(delays.size() / 2);
+  std::nth_element(delays.begin(), middle, delays.end());
+  typical_delay_ = *middle;
 }
 
 std::optional<std::size_t> SemanticFrameFilter::typicalMaskDelayFrames() const {
-  std::vector<std::size_t> delays;
-  {
-    std::lock_guard lock(mutex_);
-    delays.assign(recent_delays_.begin(), recent_delays_.end());
-  }
-  if (delays.empty()) return std::nullopt;
-  const auto middle = delays.begin() + static_cast<std::ptrdiff_t>(delays.size() / 2);
-  std::nth_element(delays.begin(), middle, delays.end());
-  return *middle;
+  std::lock_guard lock(mutex_);
+  return typical_delay_;
 }
 
 SemanticFilterCounters SemanticFrameFilter::counters() const {

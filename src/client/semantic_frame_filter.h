@@ -73,7 +73,7 @@ class SemanticFrameFilter {
   using History = std::deque<std::pair<std::size_t, std::shared_ptr<const FrameFeatures>>>;
 
   void takeCarriedMask();
-  void noteDelay(std::size_t frames);  // with mutex_ held
+  void noteDelay(std::size_t frames);  // with mutex_ held; on the delivering thread
 
   PinholeCamera camera_;
   SemanticFilterOptions options_;
@@ -88,6 +88,7 @@ class SemanticFrameFilter {
   std::optional<CarriedMask> carried_;
   SemanticFilterCounters counters_;
   std::deque<std::size_t> recent_delays_;
+  std::optional<std::size_t> typical_delay_;  // their median, kept as they arrive
 };
 
 }  // namespace edgeslam

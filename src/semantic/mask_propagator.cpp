@@ -14,19 +14,18 @@ cv::Matx33d homogeneous(const cv::Matx23d& w) {
   return cv::Matx33d(w(0, 0), w(0, 1), w(0, 2), w(1, 0), w(1, 1), w(1, 2), 0, 0, 1);
 }
 
-double scaleOf(const cv::Matx33d& h) {
-  return std::hypot(h(0, 0), h(1, 0));
+cv::Matx23d affine(const cv::Matx33d& h) {
+  return cv::Matx23d(h(0, 0), h(0, 1), h(0, 2), h(1, 0), h(1, 1), h(1, 2));
 }
 
 // `h` with its scale brought within [1/limit, limit], about `anchor` (in h's source): the anchor
 // still goes where h takes it.
 cv::Matx33d withScaleWithin(const cv::Matx33d& h, double limit, const cv::Point2d& anchor) {
-  const double scale = scaleOf(h);
+  const double scale = warpScale(affine(h));
   const double bounded = std::clamp(scale, 1.0 / limit, limit);
   if (bounded == scale || scale <= 0.0) return h;
   const double f = bounded / scale;
-  const cv::Point2d target(h(0, 0) * anchor.x + h(0, 1) * anchor.y + h(0, 2),
-                           h(1, 0) * anchor.x + h(1, 1) * anchor.y + h(1, 2));
+  const cv::Point2d target = warpPoint(affine(h), anchor);
   cv::Matx33d out = h;
   for (int r = 0; r < 2; ++r) {
     for (int c = 0; c < 2; ++c) out(r, c) = f * h(r, c);
@@ -46,17 +45,16 @@ cv::Matx23d extrapolated(const cv::Matx23d& w0, const cv::Matx23d& w1, double ra
                          const cv::Point2d& anchor) {
   const cv::Matx33d h1 = homogeneous(w1);
   const cv::Matx33d step = h1 * homogeneous(w0).inv();
-  const cv::Point2d anchor_now(w1(0, 0) * anchor.x + w1(0, 1) * anchor.y + w1(0, 2),
-                               w1(1, 0) * anchor.x + w1(1, 1) * anchor.y + w1(1, 2));
+  const cv::Point2d anchor_now = warpPoint(w1, anchor);
   const cv::Matx33d scaled = withScaleWithin(
       cv::Matx33d::eye() + ratio * (step - cv::Matx33d::eye()), step_scale_limit, anchor_now);
   const cv::Matx33d next = withScaleWithin(scaled * h1, total_scale_limit, anchor);
-  return cv::Matx23d(next(0, 0), next(0, 1), next(0, 2), next(1, 0), next(1, 1), next(1, 2));
+  return affine(next);
 }
 
 cv::Point2f apply(const cv::Matx23d& w, cv::Point2f p) {
-  return {static_cast<float>(w(0, 0) * p.x + w(0, 1) * p.y + w(0, 2)),
-          static_cast<float>(w(1, 0) * p.x + w(1, 1) * p.y + w(1, 2))};
+  const cv::Point2d q = warpPoint(w, cv::Point2d(p.x, p.y));
+  return {static_cast<float>(q.x), static_cast<float>(q.y)};
 }
 
 }  // namespace

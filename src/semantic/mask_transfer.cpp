@@ -66,8 +66,7 @@ TransferredInstance fitMotion(const std::vector<cv::Point2f>& from,
           scale <= options.max_scale_change && scale * options.max_scale_change >= 1.0;
       if (fallback.motion == InstanceMotion::kPredicted &&
           options.max_scale_change_from_prediction > 0.0) {
-        const double ratio =
-            scale / std::max(1e-6, std::hypot(fallback.warp(0, 0), fallback.warp(1, 0)));
+        const double ratio = scale / std::max(1e-6, warpScale(fallback.warp));
         plausible_scale = plausible_scale && ratio <= options.max_scale_change_from_prediction &&
                           ratio * options.max_scale_change_from_prediction >= 1.0;
       }
@@ -112,13 +111,9 @@ struct EdgeGrowth {
   bool any() const { return left + top + right + bottom > 0; }
 };
 
-cv::Point2d warped(const cv::Matx23d& w, double x, double y) {
-  return {w(0, 0) * x + w(0, 1) * y + w(0, 2), w(1, 0) * x + w(1, 1) * y + w(1, 2)};
-}
-
 EdgeGrowth growthPastCutEdges(const cv::Rect& box, const cv::Size& image, const cv::Matx23d& warp) {
   EdgeGrowth growth;
-  const double scale = std::max(1e-3, std::hypot(warp(0, 0), warp(1, 0)));
+  const double scale = std::max(1e-3, warpScale(warp));
   // Never more than the image: a wild warp must not paint a runaway strip.
   const auto pixels = [&](double inward, int limit) {
     return inward <= 0.0 ? 0 : std::min(limit, static_cast<int>(std::ceil(inward / scale)));
@@ -127,22 +122,24 @@ EdgeGrowth growthPastCutEdges(const cv::Rect& box, const cv::Size& image, const 
   constexpr int kCutTolerancePx = 2;
   const double top = box.y, bottom = box.br().y, left = box.x, right = box.br().x;
   if (box.x <= kCutTolerancePx) {
-    growth.left =
-        pixels(std::min(warped(warp, left, top).x, warped(warp, left, bottom).x), image.width);
+    growth.left = pixels(
+        std::min(warpPoint(warp, {left, top}).x, warpPoint(warp, {left, bottom}).x), image.width);
   }
   if (box.br().x >= image.width - kCutTolerancePx) {
     const double w = image.width;
-    growth.right = pixels(w - std::max(warped(warp, right, top).x, warped(warp, right, bottom).x),
-                          image.width);
+    growth.right =
+        pixels(w - std::max(warpPoint(warp, {right, top}).x, warpPoint(warp, {right, bottom}).x),
+               image.width);
   }
   if (box.y <= kCutTolerancePx) {
-    growth.top =
-        pixels(std::min(warped(warp, left, top).y, warped(warp, right, top).y), image.height);
+    growth.top = pixels(std::min(warpPoint(warp, {left, top}).y, warpPoint(warp, {right, top}).y),
+                        image.height);
   }
   if (box.br().y >= image.height - kCutTolerancePx) {
     const double h = image.height;
-    growth.bottom = pixels(
-        h - std::max(warped(warp, left, bottom).y, warped(warp, right, bottom).y), image.height);
+    growth.bottom =
+        pixels(h - std::max(warpPoint(warp, {left, bottom}).y, warpPoint(warp, {right, bottom}).y),
+               image.height);
   }
   return growth;
 }
@@ -170,7 +167,7 @@ void paintWarped(const cv::Mat1b& source, std::uint8_t label, const cv::Rect& so
       cv::Point2d(box.x, box.y), cv::Point2d(box.br().x, box.y), cv::Point2d(box.x, box.br().y),
       cv::Point2d(box.br().x, box.br().y)};
   for (std::size_t i = 0; i < 4; ++i) {
-    const cv::Point2d c = warped(warp, box_corners[i].x, box_corners[i].y);
+    const cv::Point2d c = warpPoint(warp, box_corners[i]);
     corners[i] = cv::Point2f(static_cast<float>(c.x), static_cast<float>(c.y));
   }
   const cv::Rect target_box =

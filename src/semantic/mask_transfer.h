@@ -20,6 +20,7 @@
 // The matches should be the raw keyframe -> current feature matches, including features on the
 // movable objects (before dynamic culling): those are what tell how the objects moved.
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <opencv2/core.hpp>
 #include <optional>
@@ -45,6 +46,15 @@ struct MaskTransferOptions {
   // that edge into view (its pixels on the cut repeated outwards).
   bool grow_cut_edges = true;
 };
+
+// Where a warp (keyframe pixel -> current pixel) takes a point, and its scale (a similarity's
+// uniform scale).
+inline cv::Point2d warpPoint(const cv::Matx23d& w, const cv::Point2d& p) {
+  return {w(0, 0) * p.x + w(0, 1) * p.y + w(0, 2), w(1, 0) * p.x + w(1, 1) * p.y + w(1, 2)};
+}
+inline double warpScale(const cv::Matx23d& w) {
+  return std::hypot(w(0, 0), w(1, 0));
+}
 
 enum class InstanceMotion { kSimilarity, kTranslation, kPredicted, kBackground, kIdentity };
 
