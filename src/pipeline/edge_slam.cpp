@@ -127,10 +127,13 @@ void EdgeSlam::afterFrame() {
   const std::uint64_t uploads = sink_->uploadsSent();
   if (uploads != uploads_seen_ && uploads > 0) {
     uploads_seen_ = uploads;
-    const EdgeLinkCounters link = link_->counters();
+    // Probes are counted by the link before the adaptation loop counts them, so reading the
+    // loop's count first keeps it within the link's: the other order raced with a probe in flight
+    // and gave a negative size.
     const double probes = static_cast<double>(adaptation_->counters().probe_uplink_bytes);
-    adaptation_->setMessageBytes((static_cast<double>(link.uplink_bytes) - probes) /
-                                 static_cast<double>(uploads));
+    const double uplink = static_cast<double>(link_->counters().uplink_bytes);
+    if (uplink > probes)
+      adaptation_->setMessageBytes((uplink - probes) / static_cast<double>(uploads));
   }
 }
 
