@@ -576,8 +576,8 @@ void Tracker::triangulateAtKeyFrame(KeyFrame* keyframe, Frame& frame) {
     ++triangulation_.searches;
     triangulation_.bow_searches += by_bow ? 1 : 0;
     triangulation_.pairs += pairs.size();
-    for (const auto& [index, point] :
-         createPointsFromPairs(map_, keyframe, neighbour, pairs, camera_)) {
+    for (const auto& [index, point] : createPointsFromPairs(
+             map_, keyframe, neighbour, pairs, camera_, options_.min_triangulation_parallax_deg)) {
       // The next frame finds it through the last frame (motion model) and the local map.
       frame.points[index] = point;
       frame.outliers[index] = false;

@@ -16,6 +16,7 @@
 #include "geometry/camera.h"
 #include "map/frame.h"
 #include "map/map.h"
+#include "map/pair_triangulation.h"
 #include "util/timing_stats.h"
 
 namespace edgeslam {
@@ -56,6 +57,7 @@ struct TrackerOptions {
   std::size_t triangulation_neighbours = 2;
   std::size_t triangulation_neighbours_without_bow = 1;
   float triangulation_ratio = 0.6f;  // best/second-best ratio of the pair search
+  double min_triangulation_parallax_deg = kDefaultMinTriangulationParallaxDeg;
 };
 
 // What triangulating at keyframes did (TrackerOptions::triangulate_at_keyframes).

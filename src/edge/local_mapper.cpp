@@ -292,8 +292,8 @@ void LocalMapper::createNewPoints(KeyFrame* keyframe) {
     ++searches;
     bow_searches += by_bow ? 1 : 0;
     proposed += pairs.size();
-    for (const auto& [index, point] :
-         createPointsFromPairs(map_, keyframe, neighbour, pairs, camera_)) {
+    for (const auto& [index, point] : createPointsFromPairs(
+             map_, keyframe, neighbour, pairs, camera_, options_.min_triangulation_parallax_deg)) {
       recent_points_.push_back(point);
       ++created;
     }

@@ -18,6 +18,7 @@
 #include "geometry/camera.h"
 #include "map/keyframe_sink.h"
 #include "map/map.h"
+#include "map/pair_triangulation.h"
 #include "optimize/map_optimization.h"
 #include "place/vocabulary.h"
 
@@ -40,6 +41,8 @@ struct LocalMapperOptions {
   std::size_t fusion_neighbours_depth = 10;
   // Best/second-best ratio of the epipolar descriptor search.
   float triangulation_ratio = 0.6f;
+  // Rays closer than this give no monocular point (pair_triangulation.h says why not 1.15).
+  double min_triangulation_parallax_deg = kDefaultMinTriangulationParallaxDeg;
   // kBagOfWords needs `vocabulary`; without one the band search is used.
   TriangulationSearch triangulation_search = TriangulationSearch::kBagOfWords;
   // With kBagOfWords, every keyframe is described (bag of words and direct index at

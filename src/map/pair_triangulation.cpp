@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 
@@ -37,7 +38,8 @@ PairTriangulation rejected(PairRejection why) {
 }  // namespace
 
 PairTriangulation triangulateKeypointPair(const KeyFrame& kf1, std::size_t i1, const KeyFrame& kf2,
-                                          std::size_t i2, const PinholeCamera& camera) {
+                                          std::size_t i2, const PinholeCamera& camera,
+                                          double min_parallax_deg) {
   const FrameFeatures& f1 = kf1.features();
   const FrameFeatures& f2 = kf2.features();
   if (i1 >= f1.keypoints.size() || i2 >= f2.keypoints.size()) {
@@ -54,6 +56,7 @@ PairTriangulation triangulateKeypointPair(const KeyFrame& kf1, std::size_t i1, c
   const Eigen::Vector3d ray1 = T1.rotation().conjugate() * camera.unproject(px1).normalized();
   const Eigen::Vector3d ray2 = T2.rotation().conjugate() * camera.unproject(px2).normalized();
   const double ray_cos = ray1.dot(ray2);
+  const double max_ray_cos = std::cos(min_parallax_deg * std::numbers::pi / 180.0);
   const bool depth1 = f1.hasDepth(i1), depth2 = f2.hasDepth(i2);
   // Parallax a stereo/depth measurement would give, to decide between rays and depth.
   const double depth_cos1 =
@@ -63,7 +66,7 @@ PairTriangulation triangulateKeypointPair(const KeyFrame& kf1, std::size_t i1, c
   const double depth_cos = std::min(depth_cos1, depth_cos2);
 
   std::optional<Eigen::Vector3d> x;
-  if (ray_cos > 0 && ray_cos < depth_cos && (depth1 || depth2 || ray_cos < 0.9998)) {
+  if (ray_cos > 0 && ray_cos < depth_cos && (depth1 || depth2 || ray_cos < max_ray_cos)) {
     x = triangulateDlt(T1, camera.unproject(px1).head<2>(), T2, camera.unproject(px2).head<2>());
   } else if (depth1 && depth_cos1 < depth_cos2) {
     x = kf1.poseInverse() * (camera.unproject(px1) * f1.depth[i1]);
@@ -96,11 +99,13 @@ PairTriangulation triangulateKeypointPair(const KeyFrame& kf1, std::size_t i1, c
 
 std::vector<std::pair<std::size_t, MapPoint*>> createPointsFromPairs(
     Map& map, KeyFrame* kf1, KeyFrame* kf2,
-    const std::vector<std::pair<std::size_t, std::size_t>>& pairs, const PinholeCamera& camera) {
+    const std::vector<std::pair<std::size_t, std::size_t>>& pairs, const PinholeCamera& camera,
+    double min_parallax_deg) {
   std::vector<std::pair<std::size_t, MapPoint*>> created;
   for (const auto& [i1, i2] : pairs) {
     if (kf1->point(i1) != nullptr || kf2->point(i2) != nullptr) continue;
-    const std::optional<Eigen::Vector3d> x = triangulateMatchedPair(*kf1, i1, *kf2, i2, camera);
+    const std::optional<Eigen::Vector3d> x =
+        triangulateMatchedPair(*kf1, i1, *kf2, i2, camera, min_parallax_deg);
     if (!x) continue;
     MapPoint* p = map.createMapPoint(*x, kf1);
     map.addObservation(p, kf1, i1);

@@ -101,6 +101,22 @@ TEST(PairTriangulation, NoParallaxIsRefused) {
   EXPECT_EQ(t.rejection, PairRejection::kTooLittleParallax);
 }
 
+TEST(PairTriangulation, RaysUnderTheMinimumParallaxAreRefused) {
+  const Eigen::Vector3d x(0.0, 0.0, 3.0);
+  const SE3d T1 = poseAt({0, 0, 0});
+  const SE3d T2 = poseAt({0.07, 0, 0});  // 1.34 degrees at 3 m: above ORB-SLAM2's 1.15
+  const PinholeCamera camera = test::syntheticCamera();
+  const PairOfKeyFrames pair(T1, pixelOf(camera, T1, x), 0, T2, pixelOf(camera, T2, x), 0);
+  ASSERT_GT(kDefaultMinTriangulationParallaxDeg, 1.34);
+  const PairTriangulation refused = triangulateKeypointPair(*pair.kf1, 0, *pair.kf2, 0, camera);
+  EXPECT_FALSE(refused.position.has_value());
+  EXPECT_EQ(refused.rejection, PairRejection::kTooLittleParallax);
+  const PairTriangulation accepted =
+      triangulateKeypointPair(*pair.kf1, 0, *pair.kf2, 0, camera, /*min_parallax_deg=*/1.2);
+  ASSERT_TRUE(accepted.position.has_value()) << toString(accepted.rejection);
+  EXPECT_LT((*accepted.position - x).norm(), 1e-4);
+}
+
 TEST(PairTriangulation, PointBehindTheCamerasIsRefused) {
   // Both keypoints are where a point 3 m behind both cameras projects: the rays, followed
   // forwards, diverge.
