@@ -21,8 +21,8 @@ namespace edgeslam {
 // Two rays closer than this triangulate a point whose depth is mostly noise. Worse, the noise that
 // widens a ray pair is what lets a far point through, so the points a low bound admits sit
 // systematically too close, and a monocular map built from them shrinks as it goes: on KITTI 07
-// (forward motion with two turns) 1.6 degrees instead of ORB-SLAM2's 1.15 gave an ATE of 28.9 cm
-// instead of 31.8 (medians of 6 runs), the 7-Scenes monocular run stayed at 4.0-4.2 cm.
+// (forward motion with two turns) 1.6 degrees instead of ORB-SLAM2's 1.15 gave an ATE median of
+// 29.3 cm instead of 32.1 (13 and 9 runs, alternating); 7-Scenes monocular stayed at 4.0-4.2 cm.
 inline constexpr double kDefaultMinTriangulationParallaxDeg = 1.6;
 
 enum class PairRejection {
