@@ -16,7 +16,7 @@ let snapshot = null;
 // Orbit view around `target` (display frame: y up).
 const view = { yaw: 0.6, pitch: 0.5, distance: 5, target: [0, 0, 0], fov: 1.0 };
 let follow = true;
-let needsDraw = true;
+let needsDraw = false;
 
 // SLAM poses use the camera convention (x right, y down, z forward): turn it y-up for display.
 function toDisplay(x, y, z) {

@@ -10,11 +10,11 @@ double finiteOrZero(double value) {
 }
 
 double millimetres(double metres) {
-  return std::round(metres * 1000.0) / 1000.0;
+  return std::round(metres * 1000.0) / 1000.0 + 0.0;  // + 0.0: no "-0.0" in the text
 }
 
 double fourDecimals(double value) {
-  return std::round(value * 1e4) / 1e4;
+  return std::round(value * 1e4) / 1e4 + 0.0;
 }
 
 bool isFinite(const Eigen::Vector3d& v) {
