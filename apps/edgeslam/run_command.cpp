@@ -26,6 +26,7 @@
 #include "place/vocabulary.h"
 #include "progress_line.h"
 #include "run_options.h"
+#include "run_viewer.h"
 #include "segmenter_option.h"
 #include "semantic_evaluation.h"
 #include "util/timing_stats.h"
@@ -155,10 +156,10 @@ std::unique_ptr<SlamSystem> makeSlamSystem(const RunOptions& options, const std:
 }
 
 int runPipeline(const RunOptions& options) {
-  if (options.viewer_port != 0) {
-    spdlog::warn("--viewer {}: the web viewer is not part of this build yet; running without it",
-                 options.viewer_port);
-  }
+  // First, so that a port that cannot be served ends the run before anything is loaded.
+  std::unique_ptr<RunViewer> viewer;
+  if (options.viewer_port)
+    viewer = std::make_unique<RunViewer>(options.viewer_host, *options.viewer_port);
   DatasetOptions dataset_options;
   dataset_options.format = parseDatasetFormat(options.format);
   if (options.camera_file) dataset_options.camera_override = loadCameraFile(*options.camera_file);
@@ -228,6 +229,8 @@ int runPipeline(const RunOptions& options) {
   const std::unique_ptr<SlamSystem> slam_system =
       makeSlamSystem(options, mode, reader->camera(), sensor, slam_options, edge);
   SlamSystem& slam = *slam_system;
+  const auto viewer_attachment = viewer ? viewer->attach(slam) : nullptr;
+  viz::RunStatus view_status{.frames_total = frame_count, .mode = mode, .sensor = sensor_name};
   // e2e: from the frame's arrival to its pose. With --realtime a frame arrives at its due time
   // (so a client that falls behind makes later frames wait); otherwise when it has been read.
   SampleStats client_ms, load_ms, e2e_ms;
@@ -285,10 +288,27 @@ int runPipeline(const RunOptions& options) {
       ++lost;
     }
     const double fps = static_cast<double>(i + 1) / std::max(1e-9, wall.elapsedMs() / 1000.0);
-    progress.update(fmt::format("frame {}/{}  {:.1f} fps  {}  tracked {}  kf {}  points {}", i + 1,
-                                frame_count, fps, toString(result.state), tracked,
-                                slam.keyFrameCount(), slam.mapPointCount()),
-                    i + 1 == frame_count);
+    const std::size_t keyframes = slam.keyFrameCount();
+    const std::size_t map_points = slam.mapPointCount();
+    progress.update(
+        fmt::format("frame {}/{}  {:.1f} fps  {}  tracked {}  kf {}  points {}", i + 1, frame_count,
+                    fps, toString(result.state), tracked, keyframes, map_points),
+        i + 1 == frame_count);
+    if (viewer) {
+      view_status.frame = i + 1;
+      view_status.fps = fps;
+      view_status.state = toString(result.state);
+      view_status.tracked_points = result.tracked_points;
+      view_status.keyframes = keyframes;
+      view_status.map_points = map_points;
+      view_status.client_ms = processing_ms;
+      const LinkTraffic traffic = slam.linkTraffic();
+      view_status.uplink_bytes = traffic.uplink_bytes;
+      view_status.downlink_bytes = traffic.downlink_bytes;
+      const std::optional<SE3d> camera =
+          result.T_cw ? std::optional<SE3d>(result.T_cw->inverse()) : std::nullopt;
+      viewer->view().publishFrame(view_status, camera, frame.ground_truth);
+    }
   }
   progress.finish();
   slam.finish();
@@ -393,6 +413,7 @@ int runPipeline(const RunOptions& options) {
   }
   if (ate) metrics["ate"] = *ate;
   if (ate_final) metrics["ate_final"] = *ate_final;
+  if (viewer) metrics["viewer_port"] = viewer->port();
 
   fmt::print("\nSummary\n");
   fmt::print("  dataset      {} ({})\n", info.path.string(), toString(info.format));
@@ -451,6 +472,7 @@ int runPipeline(const RunOptions& options) {
     out << metrics.dump(2) << "\n";
     spdlog::info("wrote trajectories, frames.csv and metrics.json to {}", options.out_dir.string());
   }
+  if (viewer) viewer->finish(options.viewer_linger_s);
   return 0;
 }
 
@@ -508,7 +530,16 @@ void addRunOptions(CLI::App* run, const std::shared_ptr<RunOptions>& options) {
   run->add_option("--out", options->out_dir,
                   "Output folder (trajectories, metrics.json, frames.csv with each frame's times)");
   run->add_option("--viewer", options->viewer_port,
-                  "Serve the web viewer on this port (not built yet: warns and runs without it)");
+                  "Serve the live web viewer on this port (0 = any free port; the URL is logged)")
+      ->check(CLI::Range(0, 65535));
+  run->add_option("--viewer-host", options->viewer_host,
+                  "Address the viewer listens on (0.0.0.0 = every interface)")
+      ->capture_default_str();
+  run->add_option("--viewer-linger", options->viewer_linger_s,
+                  "Keep the viewer up on the final map this many seconds after the run (Ctrl-C "
+                  "stops it)")
+      ->check(CLI::Range(0.0, 1e6))
+      ->capture_default_str();
   run->add_option("--camera", options->camera_file, "Camera YAML overriding the dataset's camera")
       ->check(CLI::ExistingFile);
   run->add_option("--vocab", options->vocabulary,

@@ -30,7 +30,9 @@ struct RunOptions {
   bool realtime = false;       // feed at the dataset's rate (default: as fast as possible)
   bool fast = false;           // explicit request for the default
   std::filesystem::path out_dir;
-  int viewer_port = 0;
+  std::optional<int> viewer_port;  // serve the web viewer (0 = any free port)
+  std::string viewer_host = "127.0.0.1";
+  double viewer_linger_s = 0.0;  // keep serving the final map this long after the run
   std::optional<std::filesystem::path> camera_file;
   // Bag-of-words vocabulary for relocalisation and loop closing; "" = the default file next to the
   // binary (vocab/orb_k10_l5.vocab) when present, "none" = without.

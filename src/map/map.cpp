@@ -297,6 +297,18 @@ std::vector<MapPoint*> Map::mapPoints() const {
   return out;
 }
 
+std::vector<Eigen::Vector3d> Map::pointPositionSample(std::size_t max_count) const {
+  std::vector<Eigen::Vector3d> out;
+  if (max_count == 0 || points_.empty()) return out;
+  const std::size_t stride = (points_.size() + max_count - 1) / max_count;
+  out.reserve(std::min(max_count, points_.size()));
+  std::size_t index = 0;
+  for (const auto& [id, point] : points_) {
+    if (index++ % stride == 0 && !point->isBad()) out.push_back(point->position());
+  }
+  return out;
+}
+
 KeyFrame* Map::keyFrame(KeyFrameId id) const {
   const auto it = keyframes_.find(id);
   return it == keyframes_.end() ? nullptr : it->second.get();

@@ -75,7 +75,10 @@ class Map {
   std::size_t pointCount() const { return points_.size(); }
   std::vector<KeyFrame*> keyFrames() const;  // sorted by id
   std::vector<MapPoint*> mapPoints() const;  // sorted by id
-  KeyFrame* keyFrame(KeyFrameId id) const;   // nullptr when absent or erased
+  // Positions of at most `max_count` points spread over the map (every k-th in storage order, no
+  // sorting): a cheap look for display while tracking waits on the mutex.
+  std::vector<Eigen::Vector3d> pointPositionSample(std::size_t max_count) const;
+  KeyFrame* keyFrame(KeyFrameId id) const;  // nullptr when absent or erased
   MapPoint* mapPoint(MapPointId id) const;
   KeyFrame* originKeyFrame() const { return origin_; }
 

@@ -218,6 +218,11 @@ void EdgeSlam::finish() {
   }
 }
 
+LinkTraffic EdgeSlam::linkTraffic() const {
+  const EdgeLinkCounters link = link_->counters();
+  return {link.uplink_bytes, link.downlink_bytes};
+}
+
 SlamCounters EdgeSlam::counters() const {
   const EdgeLinkCounters link = link_->counters();
   SlamCounters out;

@@ -35,6 +35,7 @@ class EdgeSlam : public TrackingSlam {
   // Waits (up to `timeout_s`) until every upload has been answered by a slice (or dropped).
   void finish() override;
   SlamCounters counters() const override;
+  LinkTraffic linkTraffic() const override;
   // nullptr without adaptation.
   const AdaptationLoop* adaptation() const { return adaptation_.get(); }
   const char* modeName() const override { return "edge"; }

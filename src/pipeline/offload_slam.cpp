@@ -51,6 +51,11 @@ TrackResult OffloadSlam::process(std::size_t frame_index, double timestamp, cons
   return result;
 }
 
+LinkTraffic OffloadSlam::linkTraffic() const {
+  const EdgeClientCounters c = client_->counters();
+  return {c.uplink_bytes, c.downlink_bytes};
+}
+
 SlamCounters OffloadSlam::counters() const {
   const EdgeClientCounters c = client_->counters();
   SlamCounters out;

@@ -22,6 +22,7 @@ class OffloadSlam : public SlamSystem {
                       const cv::Mat& depth, const cv::Mat& color = cv::Mat()) override;
   void finish() override {}
   SlamCounters counters() const override;
+  LinkTraffic linkTraffic() const override;
   const char* modeName() const override { return "offload"; }
 
   Trajectory trajectoryAtFrameTime() const override { return poses_; }

@@ -119,6 +119,19 @@ Trajectory TrackingSlam::keyframeTrajectory() const {
   return out;
 }
 
+MapSample TrackingSlam::mapSample(std::size_t max_points) const {
+  std::lock_guard lock(map_.updateMutex());
+  MapSample sample;
+  const std::vector<KeyFrame*> keyframes = map_.keyFrames();
+  sample.keyframe_poses.reserve(keyframes.size());
+  for (const KeyFrame* kf : keyframes) {
+    if (!kf->isBad()) sample.keyframe_poses.push_back(kf->poseInverse());
+  }
+  sample.points = map_.pointPositionSample(max_points);
+  sample.total_points = map_.pointCount();
+  return sample;
+}
+
 std::size_t TrackingSlam::keyFrameCount() const {
   std::lock_guard lock(map_.updateMutex());
   return map_.keyFrameCount();

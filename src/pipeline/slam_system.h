@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <memory>
 #include <opencv2/core.hpp>
+#include <vector>
 
 #include "client/segmentation_refresh.h"
 #include "client/semantic_frame_filter.h"
@@ -102,6 +103,19 @@ struct SlamCounters {
   PercentileSummary keyframe_ms;  // keyframe insertion, upload and the rest of the frame
 };
 
+// Bytes over the link so far (zero in local mode).
+struct LinkTraffic {
+  std::uint64_t uplink_bytes = 0;
+  std::uint64_t downlink_bytes = 0;
+};
+
+// A bounded look at the client's map for display.
+struct MapSample {
+  std::vector<SE3d> keyframe_poses;  // camera-to-world, by keyframe id
+  std::vector<Eigen::Vector3d> points;
+  std::size_t total_points = 0;  // in the client's map, of which `points` is a subsample
+};
+
 // One run mode's whole SLAM as the run command drives it.
 class SlamSystem {
  public:
@@ -115,7 +129,12 @@ class SlamSystem {
   // Lets mapping finish its backlog (call before reading the final trajectory).
   virtual void finish() = 0;
   virtual SlamCounters counters() const { return {}; }
+  // Cheap (no statistics): fit for every frame.
+  virtual LinkTraffic linkTraffic() const { return {}; }
   virtual const char* modeName() const = 0;
+  // The client's map (in edge mode the window it holds), at most `max_points` points; safe from
+  // any thread while the run goes on. Empty where the client has no map (offload).
+  virtual MapSample mapSample(std::size_t /*max_points*/) const { return {}; }
 
   // Pose of every tracked frame as it was estimated at that frame's time.
   virtual Trajectory trajectoryAtFrameTime() const = 0;
@@ -150,6 +169,7 @@ class TrackingSlam : public SlamSystem {
   Trajectory keyframeTrajectory() const override;
   std::size_t keyFrameCount() const override;
   std::size_t mapPointCount() const override;
+  MapSample mapSample(std::size_t max_points) const override;
   std::size_t relocalizations() const override { return tracker_->relocalizations(); }
   std::size_t trackingRecoveries() const override { return tracker_->recoveries(); }
   KeyFrameDecisionCounts keyFrameDecisions() const override {

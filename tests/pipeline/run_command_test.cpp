@@ -79,15 +79,6 @@ TEST(RunCommand, MissingDatasetIsAClearError) {
   EXPECT_NE(r.output.find("/nonexistent/edgeslam-data"), std::string::npos) << r.output;
 }
 
-TEST(RunCommand, ViewerThatIsNotBuiltIsSaidNotIgnored) {
-  EDGESLAM_REQUIRE_SHARED("datasets/kitti07-160");
-  const auto r =
-      test::runEdgeslam("run --dataset " + test::sharedPath("datasets/kitti07-160").string() +
-                        " --mode local --max-frames 2 --vocab none --viewer 8099");
-  EXPECT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(r.output.find("web viewer is not part of this build"), std::string::npos) << r.output;
-}
-
 TEST(RunCommand, RgbdWithoutDepthIsRejected) {
   EDGESLAM_REQUIRE_SHARED("datasets/kitti07-160");
   const auto r =

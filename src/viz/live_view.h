@@ -1,0 +1,75 @@
+#pragma once
+// The state the web viewer serves, fed by the run loop and read by the viewer's threads.
+//
+// The run loop publishes each frame's figures and pose (a few numbers under a short lock: tracking
+// never walks the map for the viewer). The map itself (keyframes, a sample of the points) is taken
+// by the reader, through the sampler the run gives, and at most once per `map_refresh`; nothing
+// is sampled or encoded while no one is watching.
+#include <chrono>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <string>
+
+#include "geometry/se3.h"
+#include "pipeline/slam_system.h"
+#include "viz/trajectory_decimator.h"
+#include "viz/view_snapshot.h"
+
+namespace edgeslam::viz {
+
+struct LiveViewOptions {
+  std::size_t max_trajectory_poses = 5000;  // per trajectory (estimate, ground truth)
+  std::size_t max_points = 20000;
+  std::size_t max_keyframes = 5000;
+  std::chrono::milliseconds map_refresh{500};
+};
+
+// Returns the map as it is now, with at most the given number of points; called from the
+// viewer's threads (so it must lock what the map needs).
+using MapSampler = std::function<MapSample(std::size_t max_points)>;
+
+class LiveView {
+ public:
+  explicit LiveView(LiveViewOptions options = {});
+
+  // After each frame. Poses are camera-to-world; `ground_truth` in the dataset's own frame (it is
+  // drawn anchored at the first frame that has both).
+  void publishFrame(const RunStatus& status, const std::optional<SE3d>& camera,
+                    const std::optional<SE3d>& ground_truth);
+  void markFinished();
+  void setMapSampler(MapSampler sampler);
+  // Drops the sampler (before what it samples goes away); the last sample stays on show.
+  void clearMapSampler();
+
+  ViewSnapshot snapshot();
+  // toJson(snapshot()).dump(), encoded at most once per change and shared by every reader.
+  std::string snapshotJson();
+  std::uint64_t version() const;
+
+ private:
+  void refreshMapIfDue();  // holds map_mutex_
+  ViewSnapshot snapshotLocked();
+
+  LiveViewOptions options_;
+
+  mutable std::mutex frame_mutex_;  // what the run loop publishes
+  std::uint64_t version_ = 0;
+  RunStatus status_;
+  std::optional<SE3d> camera_;
+  TrajectoryDecimator trajectory_;
+  TrajectoryDecimator ground_truth_;
+  std::optional<SE3d> ground_truth_anchor_;  // trajectory frame from ground-truth frame
+
+  std::mutex map_mutex_;  // the readers' side: sampler, map sample and the encoded snapshot
+  MapSampler sampler_;
+  MapSample map_;
+  std::uint64_t map_generation_ = 0;
+  std::optional<std::chrono::steady_clock::time_point> map_taken_at_;
+  std::string encoded_;
+  std::optional<std::pair<std::uint64_t, std::uint64_t>> encoded_for_;  // version, generation
+};
+
+}  // namespace edgeslam::viz

@@ -1,0 +1,181 @@
+// The viewer's HTTP server on a free loopback port, talked to with httplib's client.
+#include "viz/viewer_server.h"
+
+#include <gtest/gtest.h>
+#include <httplib.h>
+
+#include <atomic>
+#include <chrono>
+#include <future>
+#include <nlohmann/json.hpp>
+#include <thread>
+
+namespace edgeslam::viz {
+namespace {
+
+using namespace std::chrono_literals;
+
+// Limits are generous: a busy 2-core CI machine may be slow, never this slow.
+constexpr auto kPatience = 30s;
+
+class ViewerServerTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    view_.setMapSampler([](std::size_t) {
+      MapSample sample;
+      sample.keyframe_poses.push_back(SE3d());
+      sample.points = {{1, 2, 3}, {4, 5, 6}};
+      sample.total_points = 2;
+      return sample;
+    });
+    RunStatus status;
+    status.frame = 3;
+    status.frames_total = 10;
+    status.mode = "local";
+    view_.publishFrame(status, SE3d(), std::nullopt);
+    server_ = std::make_unique<ViewerServer>(ViewerServerOptions{.port = 0}, view_);
+  }
+
+  httplib::Client client() {
+    httplib::Client c("127.0.0.1", server_->port());
+    c.set_connection_timeout(10);
+    c.set_read_timeout(30);
+    return c;
+  }
+
+  LiveView view_;
+  std::unique_ptr<ViewerServer> server_;
+};
+
+TEST_F(ViewerServerTest, ServesThePageScriptAndStyle) {
+  ASSERT_GT(server_->port(), 0);
+  EXPECT_EQ(server_->url(), "http://127.0.0.1:" + std::to_string(server_->port()) + "/");
+  auto c = client();
+  const auto page = c.Get("/");
+  ASSERT_TRUE(page) << httplib::to_string(page.error());
+  EXPECT_EQ(page->status, 200);
+  EXPECT_NE(page->body.find("<canvas"), std::string::npos);
+  EXPECT_NE(page->get_header_value("Content-Type").find("text/html"), std::string::npos);
+  const auto script = c.Get("/app.js");
+  ASSERT_TRUE(script);
+  EXPECT_EQ(script->status, 200);
+  EXPECT_NE(script->body.find("EventSource"), std::string::npos);
+  EXPECT_NE(script->get_header_value("Content-Type").find("javascript"), std::string::npos);
+  const auto style = c.Get("/style.css");
+  ASSERT_TRUE(style);
+  EXPECT_EQ(style->status, 200);
+  const auto health = c.Get("/api/health");
+  ASSERT_TRUE(health);
+  EXPECT_EQ(health->status, 200);
+  EXPECT_EQ(health->body, "ok\n");
+}
+
+TEST_F(ViewerServerTest, UnknownPathsAre404) {
+  auto c = client();
+  for (const char* path : {"/nope", "/api/nope", "/app.js.map", "/index.html/.."}) {
+    const auto res = c.Get(path);
+    ASSERT_TRUE(res) << path;
+    EXPECT_EQ(res->status, 404) << path;
+  }
+}
+
+TEST_F(ViewerServerTest, StateIsTheSnapshotAsJson) {
+  auto c = client();
+  const auto res = c.Get("/api/state");
+  ASSERT_TRUE(res);
+  EXPECT_EQ(res->status, 200);
+  EXPECT_NE(res->get_header_value("Content-Type").find("application/json"), std::string::npos);
+  const auto state = nlohmann::json::parse(res->body);
+  for (const char* key : {"version", "status", "camera", "trajectory", "ground_truth", "keyframes",
+                          "points", "points_total"}) {
+    EXPECT_TRUE(state.contains(key)) << key;
+  }
+  EXPECT_EQ(state["status"]["frame"], 3);
+  EXPECT_EQ(state["status"]["mode"], "local");
+  EXPECT_EQ(state["points"].size(), 6u);
+  EXPECT_EQ(state["keyframes"].size(), 1u);
+}
+
+// Reads /api/events on a thread of its own until it ends; counts the data events.
+struct EventReader {
+  explicit EventReader(int port)
+      : thread([this, port] {
+          httplib::Client c("127.0.0.1", port);
+          c.set_connection_timeout(10);
+          c.set_read_timeout(60);
+          std::string buffer;
+          (void)c.Get("/api/events", [&](const char* data, std::size_t size) {
+            buffer.append(data, size);
+            for (std::size_t end; (end = buffer.find("\n\n")) != std::string::npos;) {
+              const std::string message = buffer.substr(0, end);
+              buffer.erase(0, end + 2);
+              if (message.rfind("data: ", 0) == 0) {
+                if (data_events++ == 0) first.set_value(message.substr(6));
+              }
+            }
+            return !stop_reading;
+          });
+          ended = true;
+        }) {}
+  ~EventReader() {
+    stop_reading = true;
+    thread.join();
+  }
+
+  std::promise<std::string> first;
+  std::future<std::string> first_data = first.get_future();
+  std::atomic<int> data_events{0};
+  std::atomic<bool> stop_reading{false};
+  std::atomic<bool> ended{false};
+  std::thread thread;
+};
+
+TEST_F(ViewerServerTest, EventsDeliverTheSnapshot) {
+  EventReader reader(server_->port());
+  ASSERT_EQ(reader.first_data.wait_for(kPatience), std::future_status::ready);
+  const auto event = nlohmann::json::parse(reader.first_data.get());
+  EXPECT_EQ(event["status"]["frame"], 3);
+  // A change is pushed too.
+  RunStatus status;
+  status.frame = 4;
+  view_.publishFrame(status, SE3d(), std::nullopt);
+  const auto deadline = std::chrono::steady_clock::now() + kPatience;
+  while (reader.data_events < 2 && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(10ms);
+  }
+  EXPECT_GE(reader.data_events.load(), 2);
+  server_->stop();
+}
+
+TEST_F(ViewerServerTest, StopsPromptlyWhileAStreamIsOpen) {
+  EventReader reader(server_->port());
+  ASSERT_EQ(reader.first_data.wait_for(kPatience), std::future_status::ready);
+  const auto start = std::chrono::steady_clock::now();
+  server_->stop();
+  // The stream ends within an event period; the bound only catches a hang (httplib would
+  // otherwise wait for the client).
+  EXPECT_LT(std::chrono::steady_clock::now() - start, 10s);
+  const auto deadline = std::chrono::steady_clock::now() + kPatience;
+  while (!reader.ended && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(10ms);
+  }
+  EXPECT_TRUE(reader.ended.load());
+  server_->stop();  // again: nothing happens
+}
+
+TEST(ViewerServer, BadPortsAreClearErrors) {
+  LiveView view;
+  EXPECT_THROW(ViewerServer(ViewerServerOptions{.port = -1}, view), ViewerError);
+  EXPECT_THROW(ViewerServer(ViewerServerOptions{.port = 65536}, view), ViewerError);
+  ViewerServer first(ViewerServerOptions{.port = 0}, view);
+  try {
+    ViewerServer second(ViewerServerOptions{.port = first.port()}, view);
+    ADD_FAILURE() << "a port in use was taken again";
+  } catch (const ViewerError& e) {
+    EXPECT_NE(std::string(e.what()).find(std::to_string(first.port())), std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace edgeslam::viz
