@@ -22,7 +22,7 @@ namespace edgeslam {
 // widens a ray pair is what lets a far point through, so the points a low bound admits sit
 // systematically too close, and a monocular map built from them shrinks as it goes: on KITTI 07
 // (forward motion with two turns) 1.6 degrees instead of ORB-SLAM2's 1.15 gave an ATE median of
-// 29.3 cm instead of 32.1 (13 and 9 runs, alternating); 7-Scenes monocular stayed at 4.0-4.2 cm.
+// 30.0 cm instead of 32.1 (16 and 9 runs, alternating); 7-Scenes monocular stayed at 4.0-4.2 cm.
 inline constexpr double kDefaultMinTriangulationParallaxDeg = 1.6;
 
 enum class PairRejection {
