@@ -83,6 +83,12 @@ TEST_F(EdgeLoopback, UploadsReachTheBackendInOrderAndSlicesStreamBack) {
   EXPECT_EQ(log->config.camera.fx(), 585.0);
   EXPECT_EQ(log->config.id_origin, client.idOrigin());
 
+  // The server keeps 4 unacknowledged slices: with the slice stream opened after the sixth upload
+  // (a busy host), the first two would be gone and the client asked to resync instead.
+  ASSERT_TRUE(test::eventually([&] {
+    const std::vector<SessionStats> sessions = server->sessions();
+    return sessions.size() == 1 && sessions[0].streaming;
+  }));
   std::mt19937 rng(21);
   constexpr int kUploads = 6;  // within the queue's capacity: none may be dropped
   for (int i = 0; i < kUploads; ++i) {
