@@ -67,7 +67,6 @@ void LiveView::refreshMapIfDue() {
 }
 
 ViewSnapshot LiveView::snapshotLocked() {
-  refreshMapIfDue();
   ViewSnapshot out;
   {
     std::lock_guard lock(frame_mutex_);
@@ -93,6 +92,7 @@ ViewSnapshot LiveView::snapshotLocked() {
 
 ViewSnapshot LiveView::snapshot() {
   std::lock_guard lock(map_mutex_);
+  refreshMapIfDue();
   return snapshotLocked();
 }
 

@@ -50,8 +50,8 @@ class LiveView {
   std::uint64_t version() const;
 
  private:
-  void refreshMapIfDue();  // holds map_mutex_
-  ViewSnapshot snapshotLocked();
+  void refreshMapIfDue();         // holds map_mutex_
+  ViewSnapshot snapshotLocked();  // holds map_mutex_, the map already refreshed
 
   LiveViewOptions options_;
 
