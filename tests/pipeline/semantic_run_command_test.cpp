@@ -63,7 +63,9 @@ void expectCulling(const nlohmann::json& m) {
   EXPECT_LT(s["dynamic_features_kept_ratio"].get<double>(), 0.8);
   EXPECT_GT(m["segmentation_ms"]["median"].get<double>(), 0.0);
   EXPECT_GE(m["tracked"].get<int>(), 85);
-  EXPECT_LT(m["ate_final"]["rmse_m"].get<double>(), 0.08);
+  // With culling 2.6-6 cm in 32 runs here, 8.3 once on a loaded CI host (edge, frames back to
+  // back); without it 13.7-15.6 cm. 10 cm tells the two apart.
+  EXPECT_LT(m["ate_final"]["rmse_m"].get<double>(), 0.10);
 }
 
 TEST(SemanticRunCommand, LocalModeSegmentsKeyframesInProcessAndCullsThePeople) {
