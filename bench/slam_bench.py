@@ -36,10 +36,10 @@ def pinned(cmd, cpu):
     return cmd if cpu is None else ["taskset", "-c", str(cpu)] + cmd
 
 
-def run_once(binary, dataset, sensor, mode, cpu, port, feed):
+def run_once(binary, dataset, sensor, mode, cpu, port, feed, extra):
     with tempfile.TemporaryDirectory() as out:
         common = ["--dataset", dataset, "--sensor", sensor, "--mode", mode, "--out", out,
-                  f"--{feed}"]
+                  f"--{feed}"] + extra
         server = None
         if mode == "local":
             cmd = pinned([binary, "run"] + common, cpu)
@@ -77,6 +77,8 @@ def main():
     parser.add_argument("--cpu", default="0", help="core to pin to; 'none' for no pinning")
     parser.add_argument("--feed", default="realtime", choices=["realtime", "fast"],
                         help="realtime: frames at the dataset's rate; fast: back to back")
+    parser.add_argument("--run-args", default="",
+                        help="extra arguments for every run, e.g. '--refine-intrinsics off'")
     parser.add_argument("--no-docs", action="store_true")
     args = parser.parse_args()
     binary = os.path.join(args.build, "edgeslam")
@@ -85,8 +87,8 @@ def main():
     lines = ["| sequence | sensor | mode | tracked | frames before init | ATE final RMSE, cm (median [min-max]) "
              "| ATE at frame time, cm | client ms median / p90 / p99 | e2e ms median / p99 "
              "| uplink KB per keyframe (per frame offload) | slice latency ms median | ORB-SLAM2 ATE "
-             "| ORB-SLAM2 ms median / p90 |",
-             "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+             "| ORB-SLAM2 ms median / p90 | refined intrinsics (fx, k1; median run) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     host_before = host_check(args.build, cpu)
     for key, mode in [(k, m) for k in args.rows.split(",") for m in args.modes.split(",")]:
         name, rel, sensor, ref_ate, ref_ms = ROWS[key]
@@ -97,7 +99,8 @@ def main():
         runs = []
         for i in range(args.runs):
             print(f"{key} {mode}: run {i + 1}/{args.runs}", file=sys.stderr, flush=True)
-            runs.append(run_once(binary, dataset, sensor, mode, cpu, args.port, args.feed))
+            runs.append(run_once(binary, dataset, sensor, mode, cpu, args.port, args.feed,
+                                 args.run_args.split()))
         ate = [100 * r["ate_final"]["rmse_m"] for r in runs if "ate_final" in r]
         ate_t = [100 * r["ate"]["rmse_m"] for r in runs if "ate" in r]
         tracked = [r["tracked"] for r in runs]
@@ -112,6 +115,11 @@ def main():
         else:
             up = [r["uplink_bytes"] / 1000 / max(1, r.get("keyframes_uploaded", 0)) for r in runs]
         slice_ms = [r["slice_latency_ms"]["median"] for r in runs]
+        refined = "-"
+        if ate and all("intrinsics_refinement" in r for r in runs):
+            by_ate = sorted(runs, key=lambda r: r["ate_final"]["rmse_m"])
+            ir = by_ate[len(by_ate) // 2]["intrinsics_refinement"]
+            refined = f"{ir['fx']:.1f}, {ir['k1']:.4f}" if ir["adopted"] else "kept"
         f2 = lambda v: f"{v:.2f}"
         f1 = lambda v: f"{v:.1f}"
         lines.append(
@@ -122,9 +130,11 @@ def main():
             f"| {f1(statistics.median(e2e))} / {f1(statistics.median(e2e99))} "
             f"| {f1(statistics.median(up)) if mode != 'local' else '-'} "
             f"| {f1(statistics.median(slice_ms)) if mode == 'edge' else '-'} "
-            f"| {ref_ate} | {ref_ms} |")
+            f"| {ref_ate} | {ref_ms} | {refined} |")
     host = host_line(host_before, host_check(args.build, cpu))
     table = "\n".join(lines) + (f"\n\n{host}" if host else "")
+    if args.run_args:
+        table += f"\n\nEvery run with `{args.run_args}`."
     print(table)
     if not args.no_docs:
         path = os.path.join(root, "docs", "benchmarks.md")

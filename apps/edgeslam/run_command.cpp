@@ -13,6 +13,7 @@
 #include "commands.h"
 #include "eval/ate.h"
 #include "frame_log.h"
+#include "intrinsics_report.h"
 #include "io/camera_file.h"
 #include "io/dataset.h"
 #include "io/frame_prefetcher.h"
@@ -205,6 +206,8 @@ int runPipeline(const RunOptions& options) {
     slam_options.mapper.triangulation_search =
         *parseTriangulationSearch(*options.triangulation_search);
   }
+  slam_options.intrinsics_refinement = parseRefinedIntrinsics(options.refine_intrinsics).value();
+  slam_options.refine_intrinsics = refinesAnything(slam_options.intrinsics_refinement);
   slam_options.semantic = options.semantic;
   slam_options.keyframe_image_reduce = options.segment_reduce;
   slam_options.segmentation_refresh.max_frames = options.segment_refresh;
@@ -414,6 +417,8 @@ int runPipeline(const RunOptions& options) {
   if (ate) metrics["ate"] = *ate;
   if (ate_final) metrics["ate_final"] = *ate_final;
   if (viewer) metrics["viewer_port"] = viewer->port();
+  const std::optional<MapIntrinsicsRefinement> refinement = slam.intrinsicsRefinement();
+  if (refinement) metrics["intrinsics_refinement"] = intrinsicsRefinementJson(*refinement);
 
   fmt::print("\nSummary\n");
   fmt::print("  dataset      {} ({})\n", info.path.string(), toString(info.format));
@@ -461,6 +466,7 @@ int runPipeline(const RunOptions& options) {
     fmt::print("  ATE final    rmse {:.4f} m  ({} poses, refined)\n",
                (*ate_final)["rmse_m"].get<double>(), (*ate_final)["pairs"].get<std::size_t>());
   }
+  if (refinement) fmt::print("  intrinsics   {}\n", intrinsicsRefinementLine(*refinement));
 
   if (!options.out_dir.empty()) {
     std::filesystem::create_directories(options.out_dir);
@@ -471,6 +477,13 @@ int runPipeline(const RunOptions& options) {
     std::ofstream out(options.out_dir / "metrics.json");
     out << metrics.dump(2) << "\n";
     spdlog::info("wrote trajectories, frames.csv and metrics.json to {}", options.out_dir.string());
+    if (refinement) {
+      if (const auto camera_file = writeRefinedCamera(options.out_dir, *refinement);
+          !camera_file.empty()) {
+        spdlog::info("refined camera written to {} (--camera starts a run with it)",
+                     camera_file.string());
+      }
+    }
   }
   if (viewer) viewer->finish(options.viewer_linger_s);
   return 0;
@@ -578,6 +591,21 @@ void addRunOptions(CLI::App* run, const std::shared_ptr<RunOptions>& options) {
   run->add_option("--starving", options->starving,
                   "Tracked ratio below which keyframe rule 1 is waived (tracking starves)")
       ->check(CLI::Range(0.0, 1.0));
+  run->add_option("--refine-intrinsics", options->refine_intrinsics,
+                  "Local mode: at the end of the run, a self-calibrating bundle adjustment "
+                  "refines these intrinsics from the map (off, or a set of focal, k1, k2) and "
+                  "re-solves the map with them where that lowers the reprojection error; "
+                  "camera_refined.yaml is written beside the trajectories")
+      ->check(CLI::Validator(
+          [](std::string& value) {
+            return parseRefinedIntrinsics(value)
+                       ? std::string()
+                       : "expected off or a comma-separated set of focal, k1, k2, got '" + value +
+                             "'";
+          },
+          "off|focal,k1,k2", "intrinsics set"))
+      ->capture_default_str()
+      ->group("Advanced");
   run->add_option("--triangulation-search", options->triangulation_search,
                   "Local mapping's new-point search: bow (direct index, needs a vocabulary) or "
                   "band (whole epipolar band); default bow")

@@ -157,4 +157,37 @@ LocalBundleAdjustmentStats globalBundleAdjustment(Map& map, const PinholeCamera&
   return solveAndApply(map, std::move(build), options);
 }
 
+MapIntrinsicsRefinement refineMapIntrinsics(Map& map, const PinholeCamera& camera,
+                                            const IntrinsicsRefinementOptions& options) {
+  ProblemBuild build;
+  {
+    std::lock_guard lock(map.updateMutex());
+    build = buildProblem(map.keyFrames(), map.originKeyFrame(), camera);
+  }
+  MapIntrinsicsRefinement out;
+  out.keyframes = build.keyframes.size();
+  out.points = build.points.size();
+  if (build.problem.observations.empty()) {
+    out.result.reason = "the map has no observations";
+    out.result.intrinsics = camera.intrinsics();
+    return out;
+  }
+  Stopwatch timer;
+  out.result = refineIntrinsics(build.problem, camera, options);
+  out.solve_ms = timer.elapsedMs();
+  if (!out.result.adopted) return out;
+  std::lock_guard lock(map.updateMutex());
+  for (std::size_t k = 0; k < build.keyframes.size(); ++k) {
+    if (build.problem.keyframes[k].fixed || build.keyframes[k]->isBad()) continue;
+    map.setKeyFramePose(build.keyframes[k], out.result.T_cw[k]);
+  }
+  for (std::size_t i = 0; i < build.points.size(); ++i) {
+    MapPoint* p = build.points[i];
+    if (p->isBad()) continue;
+    map.setPointPosition(p, out.result.points[i]);
+    map.refreshPoint(p);
+  }
+  return out;
+}
+
 }  // namespace edgeslam

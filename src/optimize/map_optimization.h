@@ -8,6 +8,7 @@
 #include "geometry/camera.h"
 #include "map/frame.h"
 #include "map/map.h"
+#include "optimize/intrinsics_refinement.h"
 #include "optimize/local_bundle_adjustment.h"
 #include "optimize/pose_optimizer.h"
 
@@ -40,5 +41,20 @@ LocalBundleAdjustmentStats localBundleAdjustment(Map& map, KeyFrame* keyframe,
 LocalBundleAdjustmentStats globalBundleAdjustment(Map& map, const PinholeCamera& camera,
                                                   const std::atomic<bool>* cancel = nullptr,
                                                   int iterations = 20);
+
+struct MapIntrinsicsRefinement {
+  IntrinsicsRefinementResult result;
+  std::size_t keyframes = 0;
+  std::size_t points = 0;
+  double solve_ms = 0.0;
+};
+
+// Self-calibrating global bundle adjustment (intrinsics_refinement.h) over every keyframe and
+// point, the origin keyframe fixed. When the refinement is adopted the map takes its keyframe
+// poses and point positions; the keyframes' keypoints stay undistorted with `camera`, so this is
+// for a finished map (the end of a run), whose refined camera the caller reports. Same locking as
+// above.
+MapIntrinsicsRefinement refineMapIntrinsics(Map& map, const PinholeCamera& camera,
+                                            const IntrinsicsRefinementOptions& options = {});
 
 }  // namespace edgeslam

@@ -23,17 +23,22 @@ class LocalSlam : public TrackingSlam {
   SlamCounters counters() const override;
   // nullptr without a vocabulary or with loop closing off.
   const LoopCloser* loopCloser() const { return loop_closer_.get(); }
+  std::optional<MapIntrinsicsRefinement> intrinsicsRefinement() const override {
+    return intrinsics_refinement_;
+  }
 
  private:
   void afterFrame() override;
   void afterTracking(const TrackResult& result, std::size_t frame_index,
                      const cv::Mat& image) override;
   void onSegmented(KeyFrameSegmentationResult result);
+  void refineIntrinsicsOfTheMap();
 
   std::unique_ptr<LocalMapper> mapper_;
   std::unique_ptr<LoopCloser> loop_closer_;
   std::unique_ptr<KeyFrameSegmentationWorker> segmentation_;
   std::atomic<std::uint64_t> movable_points_erased_{0};
+  std::optional<MapIntrinsicsRefinement> intrinsics_refinement_;
 };
 
 }  // namespace edgeslam

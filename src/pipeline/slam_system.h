@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <memory>
 #include <opencv2/core.hpp>
+#include <optional>
 #include <vector>
 
 #include "client/segmentation_refresh.h"
@@ -16,6 +17,7 @@
 #include "features/orb_extractor.h"
 #include "io/trajectory.h"
 #include "map/map.h"
+#include "optimize/map_optimization.h"
 #include "place/vocabulary.h"
 #include "semantic/segmenter.h"
 #include "util/timing_stats.h"
@@ -54,6 +56,11 @@ struct SlamOptions {
   // that people walking into view are segmented soon; the interval follows the masks' delay
   // (client/segmentation_refresh.h, KeyFrameParameters::segmentation_refresh).
   SegmentationRefreshOptions segmentation_refresh;
+  // Local mode: when the run finishes, a self-calibrating global bundle adjustment refines the
+  // focal length and radial distortion from the map itself and, where the data asks for it,
+  // re-solves the map with them (optimize/intrinsics_refinement.h).
+  bool refine_intrinsics = true;
+  IntrinsicsRefinementOptions intrinsics_refinement;
 };
 
 // Nice 10 gives a thread about a tenth of the CPU against a nice-0 one.
@@ -135,6 +142,10 @@ class SlamSystem {
   // The client's map (in edge mode the window it holds), at most `max_points` points; safe from
   // any thread while the run goes on. Empty where the client has no map (offload).
   virtual MapSample mapSample(std::size_t /*max_points*/) const { return {}; }
+  // The end-of-run intrinsics refinement, once finish() has run it (local mode).
+  virtual std::optional<MapIntrinsicsRefinement> intrinsicsRefinement() const {
+    return std::nullopt;
+  }
 
   // Pose of every tracked frame as it was estimated at that frame's time.
   virtual Trajectory trajectoryAtFrameTime() const = 0;

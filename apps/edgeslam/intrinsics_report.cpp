@@ -1,0 +1,49 @@
+#include "intrinsics_report.h"
+
+#include <fmt/format.h>
+
+#include "io/camera_file.h"
+
+namespace edgeslam::cli {
+
+nlohmann::json intrinsicsRefinementJson(const MapIntrinsicsRefinement& refinement) {
+  const IntrinsicsRefinementResult& r = refinement.result;
+  const CameraIntrinsics& in = r.intrinsics;
+  nlohmann::json json = {{"adopted", r.adopted},
+                         {"fx", in.fx},
+                         {"fy", in.fy},
+                         {"k1", in.distortion.k1},
+                         {"k2", in.distortion.k2},
+                         {"rms_before_px", r.rms_before},
+                         {"rms_after_px", r.rms_after},
+                         {"iterations", r.iterations},
+                         {"keyframes", refinement.keyframes},
+                         {"points", refinement.points},
+                         {"inliers", r.inliers},
+                         {"outliers", r.outliers},
+                         {"ms", refinement.solve_ms}};
+  if (!r.adopted) json["reason"] = r.reason;
+  return json;
+}
+
+std::string intrinsicsRefinementLine(const MapIntrinsicsRefinement& refinement) {
+  const IntrinsicsRefinementResult& r = refinement.result;
+  if (!r.adopted) {
+    return fmt::format("kept: {} ({:.0f} ms)", r.reason, refinement.solve_ms);
+  }
+  const CameraIntrinsics& in = r.intrinsics;
+  return fmt::format("refined fx {:.2f} fy {:.2f} k1 {:.4f} k2 {:.4f}, reprojection RMS {:.3f} -> "
+                     "{:.3f} px ({:.0f} ms)",
+                     in.fx, in.fy, in.distortion.k1, in.distortion.k2, r.rms_before, r.rms_after,
+                     refinement.solve_ms);
+}
+
+std::filesystem::path writeRefinedCamera(const std::filesystem::path& out_dir,
+                                         const MapIntrinsicsRefinement& refinement) {
+  if (!refinement.result.adopted || out_dir.empty()) return {};
+  const std::filesystem::path path = out_dir / "camera_refined.yaml";
+  saveCameraFile(path, refinement.result.intrinsics);
+  return path;
+}
+
+}  // namespace edgeslam::cli
