@@ -206,7 +206,11 @@ int runPipeline(const RunOptions& options) {
     slam_options.mapper.triangulation_search =
         *parseTriangulationSearch(*options.triangulation_search);
   }
-  slam_options.intrinsics_refinement = parseRefinedIntrinsics(options.refine_intrinsics).value();
+  const IntrinsicsRefinementOptions refined =
+      parseRefinedIntrinsics(options.refine_intrinsics).value();
+  slam_options.intrinsics_refinement.refine_focal = refined.refine_focal;
+  slam_options.intrinsics_refinement.refine_k1 = refined.refine_k1;
+  slam_options.intrinsics_refinement.refine_k2 = refined.refine_k2;
   slam_options.refine_intrinsics = refinesAnything(slam_options.intrinsics_refinement);
   slam_options.semantic = options.semantic;
   slam_options.keyframe_image_reduce = options.segment_reduce;

@@ -5,8 +5,9 @@
 #include <ceres/manifold.h>
 #include <ceres/ordered_groups.h>
 #include <ceres/problem.h>
-#include <ceres/solver.h>
 #include <ceres/sized_cost_function.h>
+#include <ceres/solver.h>
+#include <fmt/format.h>
 
 #include <array>
 #include <cmath>
@@ -61,8 +62,7 @@ class IntrinsicsReprojectionCost final
     : public ceres::SizedCostFunction<kResiduals, kPoseBlockSize, 3, 3> {
  public:
   explicit IntrinsicsReprojectionCost(const RawProjection<kResiduals>& projection)
-      : projection_(projection),
-        inner_(new RawProjection<kResiduals>(projection)) {}
+      : projection_(projection), inner_(new RawProjection<kResiduals>(projection)) {}
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
@@ -122,8 +122,8 @@ class IntrinsicsSolver {
         loss_mono_(std::make_unique<ceres::HuberLoss>(std::sqrt(kChi2Mono95))),
         loss_stereo_(std::make_unique<ceres::HuberLoss>(std::sqrt(kChi2Stereo95))) {
     const Distortion& d = camera.intrinsics().distortion;
-    model_ = {camera.fx(), camera.fy(), camera.cx(), camera.cy(), d.p1, d.p2, d.k3,
-              problem.camera.bf};
+    model_ = {camera.fx(), camera.fy(), camera.cx(), camera.cy(),
+              d.p1,        d.p2,        d.k3,        problem.camera.bf};
     intrinsics_ = {1.0, d.k1, d.k2};
     for (const BAKeyFrame& kf : problem.keyframes) poses_.push_back(toPoseBlock(kf.T_cw));
     for (const BAPoint& p : problem.points) points_.push_back(p.position);
@@ -131,12 +131,13 @@ class IntrinsicsSolver {
       const Eigen::Vector2d raw = camera.hasDistortion() ? camera.distort(o.pixel) : o.pixel;
       const double weight = std::sqrt(o.inv_sigma2);
       if (o.right_u) {
-        stereo_.emplace_back(RawProjection<kStereoResiduals>{
-            model_, raw, o.pixel.x() - *o.right_u, weight});
+        stereo_.emplace_back(
+            RawProjection<kStereoResiduals>{model_, raw, o.pixel.x() - *o.right_u, weight});
       } else {
         mono_.emplace_back(RawProjection<kMonoResiduals>{model_, raw, 0.0, weight});
       }
-      index_.push_back(o.right_u ? -static_cast<long>(stereo_.size()) : static_cast<long>(mono_.size()));
+      index_.push_back(o.right_u ? -static_cast<long>(stereo_.size())
+                                 : static_cast<long>(mono_.size()));
     }
   }
 
@@ -162,12 +163,17 @@ class IntrinsicsSolver {
     result.intrinsics = refinedIntrinsics();
     const double gain = rms_fixed > 0.0 ? 1.0 - rms_refined / rms_fixed : 0.0;
     if (std::abs(intrinsics_[0] - 1.0) > options_.max_focal_change) {
-      result.reason = "focal change beyond the allowed bound";
+      result.reason =
+          fmt::format("focal length change {:+.1f} % beyond the allowed {:.0f} %",
+                      100.0 * (intrinsics_[0] - 1.0), 100.0 * options_.max_focal_change);
     } else if (std::abs(intrinsics_[1]) > options_.max_abs_k ||
                std::abs(intrinsics_[2]) > options_.max_abs_k) {
-      result.reason = "distortion beyond the allowed bound";
+      result.reason = fmt::format("distortion k1 {:.3f} k2 {:.3f} beyond the allowed {:.2f}",
+                                  intrinsics_[1], intrinsics_[2], options_.max_abs_k);
     } else if (gain < options_.min_rms_gain) {
-      result.reason = "the data does not ask for it (reprojection RMS gain under the threshold)";
+      result.reason = fmt::format(
+          "the data does not ask for it (reprojection RMS {:.2f} % lower, under {:.2f} %)",
+          100.0 * gain, 100.0 * options_.min_rms_gain);
     } else {
       result.adopted = true;
       if (readmitInliers() > 0) {

@@ -40,7 +40,7 @@ struct IntrinsicsRefinementOptions {
 
 struct IntrinsicsRefinementResult {
   bool adopted = false;
-  std::string reason;  // why not adopted (empty when adopted)
+  std::string reason;           // why not adopted (empty when adopted)
   CameraIntrinsics intrinsics;  // the refined intrinsics (the input's when not adopted)
   double focal_scale = 1.0;
   // Pixels per residual component, both over the observations the given intrinsics keep as
@@ -48,10 +48,10 @@ struct IntrinsicsRefinementResult {
   double rms_before = 0.0;  // the given intrinsics, after a bundle adjustment with them
   double rms_after = 0.0;   // the refined ones
   int iterations = 0;
-  std::size_t inliers = 0;   // observations in the final solve
-  std::size_t outliers = 0;  // left out of it (chi-square test, or behind the camera)
-  std::vector<SE3d> T_cw;                 // per problem keyframe (fixed ones unchanged)
-  std::vector<Eigen::Vector3d> points;    // per problem point
+  std::size_t inliers = 0;              // observations in the final solve
+  std::size_t outliers = 0;             // left out of it (chi-square test, or behind the camera)
+  std::vector<SE3d> T_cw;               // per problem keyframe (fixed ones unchanged)
+  std::vector<Eigen::Vector3d> points;  // per problem point
 };
 
 // "off", or a comma-separated set of focal, k1, k2 (e.g. "focal,k1"); nullopt when malformed.

@@ -117,9 +117,9 @@ TEST(IntrinsicsRefinement, CorrectIntrinsicsAreKept) {
   // The poses are the fixed-intrinsics solve's: still the true ones up to noise.
   ASSERT_EQ(r.T_cw.size(), scene.true_poses.size());
   for (std::size_t k = 1; k < r.T_cw.size(); ++k) {
-    EXPECT_LT((r.T_cw[k].inverse().translation() - scene.true_poses[k].inverse().translation())
-                  .norm(),
-              0.05)
+    EXPECT_LT(
+        (r.T_cw[k].inverse().translation() - scene.true_poses[k].inverse().translation()).norm(),
+        0.05)
         << "keyframe " << k;
   }
 }
