@@ -22,7 +22,13 @@ nlohmann::json intrinsicsRefinementJson(const MapIntrinsicsRefinement& refinemen
                          {"inliers", r.inliers},
                          {"outliers", r.outliers},
                          {"ms", refinement.solve_ms}};
-  if (!r.adopted) json["reason"] = r.reason;
+  if (!r.adopted) {
+    json["reason"] = r.reason;
+    json["estimate"] = {{"fx", r.estimate.fx},
+                        {"fy", r.estimate.fy},
+                        {"k1", r.estimate.distortion.k1},
+                        {"k2", r.estimate.distortion.k2}};
+  }
   return json;
 }
 

@@ -161,6 +161,7 @@ class IntrinsicsSolver {
     result.rms_after = rms_refined;
     result.focal_scale = intrinsics_[0];
     result.intrinsics = refinedIntrinsics();
+    result.estimate = result.intrinsics;
     const double gain = rms_fixed > 0.0 ? 1.0 - rms_refined / rms_fixed : 0.0;
     if (std::abs(intrinsics_[0] - 1.0) > options_.max_focal_change) {
       result.reason =
@@ -181,6 +182,7 @@ class IntrinsicsSolver {
         if (!solve(result)) return abandoned(result);
       }
       result.intrinsics = refinedIntrinsics();
+      result.estimate = result.intrinsics;
       result.focal_scale = intrinsics_[0];
     }
     for (const ceres::ResidualBlockId id : residual_ids_) result.inliers += id != nullptr ? 1 : 0;
@@ -197,7 +199,7 @@ class IntrinsicsSolver {
   IntrinsicsRefinementResult abandoned(IntrinsicsRefinementResult& result) {
     result.adopted = false;
     result.reason = "the solver stopped (cancelled or failed)";
-    result.intrinsics = input_camera_intrinsics_;
+    result.intrinsics = result.estimate = input_camera_intrinsics_;
     for (const BAKeyFrame& kf : input_.keyframes) result.T_cw.push_back(kf.T_cw);
     for (const BAPoint& p : input_.points) result.points.push_back(p.position);
     return result;
@@ -393,7 +395,7 @@ IntrinsicsRefinementResult refineIntrinsics(const BundleAdjustmentProblem& probl
   if (free_keyframes < options.min_keyframes) {
     IntrinsicsRefinementResult result;
     result.reason = "too few keyframes (" + std::to_string(free_keyframes) + ")";
-    result.intrinsics = camera.intrinsics();
+    result.intrinsics = result.estimate = camera.intrinsics();
     for (const BAKeyFrame& kf : problem.keyframes) result.T_cw.push_back(kf.T_cw);
     for (const BAPoint& p : problem.points) result.points.push_back(p.position);
     return result;

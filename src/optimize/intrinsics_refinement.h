@@ -42,6 +42,7 @@ struct IntrinsicsRefinementResult {
   bool adopted = false;
   std::string reason;           // why not adopted (empty when adopted)
   CameraIntrinsics intrinsics;  // the refined intrinsics (the input's when not adopted)
+  CameraIntrinsics estimate;    // what the data asked for, adopted or not
   double focal_scale = 1.0;
   // Pixels per residual component, both over the observations the given intrinsics keep as
   // inliers (so that the two are comparable).

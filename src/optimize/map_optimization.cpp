@@ -169,7 +169,7 @@ MapIntrinsicsRefinement refineMapIntrinsics(Map& map, const PinholeCamera& camer
   out.points = build.points.size();
   if (build.problem.observations.empty()) {
     out.result.reason = "the map has no observations";
-    out.result.intrinsics = camera.intrinsics();
+    out.result.intrinsics = out.result.estimate = camera.intrinsics();
     return out;
   }
   Stopwatch timer;

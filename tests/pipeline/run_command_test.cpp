@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "io/camera_file.h"
 #include "io/trajectory.h"
 #include "support/edgeslam_command.h"
 #include "support/shared_data.h"
@@ -71,6 +72,58 @@ TEST(RunCommand, WritesTheContractOutputs) {
   }
   EXPECT_EQ(rows, 40u);
   EXPECT_GE(keyframes, 1u);
+}
+
+// KITTI 07's calibration bends the monocular map in its first turn; the end-of-run self-calibration
+// finds the images' focal length and k1, and a second run started from camera_refined.yaml tracks
+// with them live (docs/self_calibration.md).
+TEST(RunCommand, LocalRunSelfCalibratesAndTheRefinedCameraCarriesOver) {
+  EDGESLAM_REQUIRE_SHARED("datasets/kitti07-160");
+  const std::string kitti = test::sharedPath("datasets/kitti07-160").string();
+  const auto first = freshDir("selfcal_first");
+  auto r = test::runEdgeslam("run --dataset " + kitti + " --sensor mono --mode local " +
+                             "--max-frames 80 --realtime --out " + first.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("intrinsics   refined fx"), std::string::npos) << r.output;
+  std::ifstream in(first / "metrics.json");
+  const auto metrics = nlohmann::json::parse(in);
+  ASSERT_TRUE(metrics.contains("intrinsics_refinement"));
+  const auto& refinement = metrics["intrinsics_refinement"];
+  ASSERT_TRUE(refinement["adopted"].get<bool>()) << refinement.dump();
+  const double fx = refinement["fx"].get<double>();
+  EXPECT_GT(fx, 680.0);  // given 707.09; 697-701 measured
+  EXPECT_LT(fx, 707.0);
+  EXPECT_GT(refinement["k1"].get<double>(), 0.0);
+  EXPECT_LT(refinement["rms_after_px"].get<double>(), refinement["rms_before_px"].get<double>());
+  const auto camera_file = first / "camera_refined.yaml";
+  ASSERT_TRUE(std::filesystem::exists(camera_file));
+  const CameraIntrinsics refined = loadCameraFile(camera_file);
+  EXPECT_DOUBLE_EQ(refined.fx, fx);
+  EXPECT_DOUBLE_EQ(refined.cx, 601.8873);
+  const double first_live_ate = metrics["ate"]["rmse_m"].get<double>();
+  const double first_final_ate = metrics["ate_final"]["rmse_m"].get<double>();
+  EXPECT_LT(first_final_ate, 0.75 * first_live_ate);
+
+  // Started from the refined camera, tracking itself no longer drifts in the turn, and the data
+  // has nothing more to ask for.
+  const auto second = freshDir("selfcal_second");
+  r = test::runEdgeslam("run --dataset " + kitti + " --sensor mono --mode local " +
+                        "--max-frames 80 --realtime --camera " + camera_file.string() +
+                        " --refine-intrinsics off --out " + second.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::ifstream in2(second / "metrics.json");
+  const auto metrics2 = nlohmann::json::parse(in2);
+  EXPECT_FALSE(metrics2.contains("intrinsics_refinement"));
+  EXPECT_FALSE(std::filesystem::exists(second / "camera_refined.yaml"));
+  EXPECT_LT(metrics2["ate"]["rmse_m"].get<double>(), 0.75 * first_live_ate);
+}
+
+TEST(RunCommand, BadRefinedIntrinsicsSetIsAClearError) {
+  const auto r = test::runEdgeslam("run --dataset /tmp --refine-intrinsics focal,fx");
+  EXPECT_NE(r.exit_code, 0);
+  EXPECT_NE(r.output.find("expected off or a comma-separated set of focal, k1, k2"),
+            std::string::npos)
+      << r.output;
 }
 
 TEST(RunCommand, MissingDatasetIsAClearError) {
