@@ -206,8 +206,12 @@ int runPipeline(const RunOptions& options) {
     slam_options.mapper.triangulation_search =
         *parseTriangulationSearch(*options.triangulation_search);
   }
+  if (options.refine_intrinsics && mode != "local") {
+    spdlog::warn("--refine-intrinsics applies to --mode local only; the {} run keeps the camera",
+                 mode);
+  }
   const IntrinsicsRefinementOptions refined =
-      parseRefinedIntrinsics(options.refine_intrinsics).value();
+      parseRefinedIntrinsics(options.refine_intrinsics.value_or("focal,k1")).value();
   slam_options.intrinsics_refinement.refine_focal = refined.refine_focal;
   slam_options.intrinsics_refinement.refine_k1 = refined.refine_k1;
   slam_options.intrinsics_refinement.refine_k2 = refined.refine_k2;
@@ -608,7 +612,7 @@ void addRunOptions(CLI::App* run, const std::shared_ptr<RunOptions>& options) {
                              "'";
           },
           "off|focal,k1,k2", "intrinsics set"))
-      ->capture_default_str()
+      ->default_str("focal,k1")
       ->group("Advanced");
   run->add_option("--triangulation-search", options->triangulation_search,
                   "Local mapping's new-point search: bow (direct index, needs a vocabulary) or "

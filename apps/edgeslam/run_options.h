@@ -51,8 +51,8 @@ struct RunOptions {
   std::optional<int> fmin, fmax;
   std::optional<double> alpha, beta, starving;
   // Local mode: intrinsics the end-of-run self-calibration refines ("off" or a set of focal, k1,
-  // k2; optimize/intrinsics_refinement.h).
-  std::string refine_intrinsics = "focal,k1";
+  // k2; optimize/intrinsics_refinement.h); unset = focal,k1.
+  std::optional<std::string> refine_intrinsics;
   // Local mapping's new-point search: "bow" or "band"; unset = LocalMapperOptions' default.
   std::optional<std::string> triangulation_search;
 };
