@@ -163,14 +163,17 @@ class IntrinsicsSolver {
     result.intrinsics = refinedIntrinsics();
     result.estimate = result.intrinsics;
     const double gain = rms_fixed > 0.0 ? 1.0 - rms_refined / rms_fixed : 0.0;
+    const double given_k1 = input_camera_intrinsics_.distortion.k1;
+    const double given_k2 = input_camera_intrinsics_.distortion.k2;
     if (std::abs(intrinsics_[0] - 1.0) > options_.max_focal_change) {
       result.reason =
           fmt::format("focal length change {:+.1f} % beyond the allowed {:.0f} %",
                       100.0 * (intrinsics_[0] - 1.0), 100.0 * options_.max_focal_change);
-    } else if (std::abs(intrinsics_[1]) > options_.max_abs_k ||
-               std::abs(intrinsics_[2]) > options_.max_abs_k) {
-      result.reason = fmt::format("distortion k1 {:.3f} k2 {:.3f} beyond the allowed {:.2f}",
-                                  intrinsics_[1], intrinsics_[2], options_.max_abs_k);
+    } else if (std::abs(intrinsics_[1] - given_k1) > options_.max_distortion_change ||
+               std::abs(intrinsics_[2] - given_k2) > options_.max_distortion_change) {
+      result.reason = fmt::format(
+          "distortion change k1 {:+.3f} k2 {:+.3f} beyond the allowed {:.2f}",
+          intrinsics_[1] - given_k1, intrinsics_[2] - given_k2, options_.max_distortion_change);
     } else if (gain < options_.min_rms_gain) {
       result.reason = fmt::format(
           "the data does not ask for it (reprojection RMS {:.2f} % lower, under {:.2f} %)",

@@ -31,8 +31,8 @@ struct IntrinsicsRefinementOptions {
   // The refinement is adopted only if it lowers the reprojection RMS of the inliers by this
   // fraction (a change the data does not ask for is not made) and stays within these bounds.
   double min_rms_gain = 0.004;
-  double max_focal_change = 0.08;  // relative
-  double max_abs_k = 0.3;
+  double max_focal_change = 0.08;      // relative
+  double max_distortion_change = 0.2;  // of k1 and of k2, from the given values
   // Fewer free keyframes than this see too few directions to tell focal length from structure.
   std::size_t min_keyframes = 8;
   const std::atomic<bool>* cancel = nullptr;

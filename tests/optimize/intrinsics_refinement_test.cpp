@@ -106,6 +106,19 @@ TEST(IntrinsicsRefinement, StartsFromTheAssumedDistortion) {
   EXPECT_NEAR(r.intrinsics.distortion.k1, 0.06, 0.01);
 }
 
+TEST(IntrinsicsRefinement, StrongGivenDistortionIsNoObstacle) {
+  // A lens like TUM fr2's (k2 = -0.78): the bounds apply to the change, not to the values.
+  const PinholeCamera truth(intrinsics(480.0, 0.26, -0.78));
+  const PinholeCamera assumed(intrinsics(480.0, 0.23, -0.78));
+  const Scene scene = makeTurningScene(truth, assumed, 0.3);
+  IntrinsicsRefinementOptions options;
+  options.refine_focal = false;
+  const IntrinsicsRefinementResult r = refineIntrinsics(scene.problem, assumed, options);
+  ASSERT_TRUE(r.adopted) << r.reason;
+  EXPECT_NEAR(r.intrinsics.distortion.k1, 0.26, 0.01);
+  EXPECT_EQ(r.intrinsics.distortion.k2, -0.78);
+}
+
 TEST(IntrinsicsRefinement, CorrectIntrinsicsAreKept) {
   const PinholeCamera truth(intrinsics(480.0, 0.03));
   const Scene scene = makeTurningScene(truth, truth, 0.3);
