@@ -87,6 +87,9 @@ std::optional<OffloadResult> SlamSessionBackend::onFrame(OffloadFrame frame) {
     slam_options.orb.scale_factor = config_.settings.scale_factor;
     slam_options.semantic = segmenter_ != nullptr;
     slam_options.segmenter = segmenter_;
+    // Each frame's pose goes back as it is tracked; nothing would carry an end-of-session
+    // refinement to the client.
+    slam_options.refine_intrinsics = false;
     offload_ = std::make_unique<LocalSlam>(config_.camera, slam_options);
   }
   const TrackResult tracked = offload_->process(frame.frame_index, frame.timestamp, gray, depth);
