@@ -1,7 +1,5 @@
 #include "intrinsics_report.h"
 
-#include <fmt/format.h>
-
 #include "io/camera_file.h"
 
 namespace edgeslam::cli {
@@ -30,19 +28,6 @@ nlohmann::json intrinsicsRefinementJson(const MapIntrinsicsRefinement& refinemen
                         {"k2", r.estimate.distortion.k2}};
   }
   return json;
-}
-
-std::string intrinsicsRefinementLine(const MapIntrinsicsRefinement& refinement) {
-  const IntrinsicsRefinementResult& r = refinement.result;
-  if (!r.adopted) {
-    return fmt::format("kept: {} ({:.0f} ms)", r.reason, refinement.solve_ms);
-  }
-  const CameraIntrinsics& in = r.intrinsics;
-  return fmt::format(
-      "refined fx {:.2f} fy {:.2f} k1 {:.4f} k2 {:.4f}, reprojection RMS {:.3f} -> "
-      "{:.3f} px ({:.0f} ms)",
-      in.fx, in.fy, in.distortion.k1, in.distortion.k2, r.rms_before, r.rms_after,
-      refinement.solve_ms);
 }
 
 std::filesystem::path writeRefinedCamera(const std::filesystem::path& out_dir,

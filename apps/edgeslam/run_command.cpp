@@ -210,11 +210,11 @@ int runPipeline(const RunOptions& options) {
     spdlog::warn("--refine-intrinsics applies to --mode local only; the {} run keeps the camera",
                  mode);
   }
-  const IntrinsicsRefinementOptions refined =
-      parseRefinedIntrinsics(options.refine_intrinsics.value_or("focal,k1")).value();
-  slam_options.intrinsics_refinement.refine_focal = refined.refine_focal;
-  slam_options.intrinsics_refinement.refine_k1 = refined.refine_k1;
-  slam_options.intrinsics_refinement.refine_k2 = refined.refine_k2;
+  // The sensor's bounds (defaultSlamOptions) stay; the flag picks what is refined.
+  slam_options.intrinsics_refinement =
+      parseRefinedIntrinsics(options.refine_intrinsics.value_or("focal,k1"),
+                             slam_options.intrinsics_refinement)
+          .value();
   slam_options.refine_intrinsics = refinesAnything(slam_options.intrinsics_refinement);
   slam_options.semantic = options.semantic;
   slam_options.keyframe_image_reduce = options.segment_reduce;
@@ -474,7 +474,7 @@ int runPipeline(const RunOptions& options) {
     fmt::print("  ATE final    rmse {:.4f} m  ({} poses, refined)\n",
                (*ate_final)["rmse_m"].get<double>(), (*ate_final)["pairs"].get<std::size_t>());
   }
-  if (refinement) fmt::print("  intrinsics   {}\n", intrinsicsRefinementLine(*refinement));
+  if (refinement) fmt::print("  intrinsics   {}\n", describe(*refinement));
 
   if (!options.out_dir.empty()) {
     std::filesystem::create_directories(options.out_dir);

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <memory>
 #include <stdexcept>
+#include <utility>
 
 #include "optimize/reprojection_error.h"
 #include "optimize/se3_manifold.h"
@@ -94,24 +95,6 @@ class IntrinsicsReprojectionCost final
   ceres::AutoDiffCostFunction<RawProjection<kResiduals>, kResiduals, 3, 3> inner_;
 };
 
-void validate(const BundleAdjustmentProblem& problem, const IntrinsicsRefinementOptions& options) {
-  problem.camera.validate();
-  if (!refinesAnything(options)) {
-    throw std::invalid_argument("refineIntrinsics: nothing to refine (focal, k1 and k2 all off)");
-  }
-  if (options.iterations <= 0) {
-    throw std::invalid_argument("refineIntrinsics: iterations must be positive");
-  }
-  for (std::size_t i = 0; i < problem.observations.size(); ++i) {
-    const BAObservation& o = problem.observations[i];
-    if (o.keyframe >= problem.keyframes.size() || o.point >= problem.points.size() ||
-        !o.pixel.allFinite() || !(o.inv_sigma2 > 0.0) || !std::isfinite(o.inv_sigma2)) {
-      throw std::invalid_argument("refineIntrinsics: observation " + std::to_string(i) +
-                                  " is malformed");
-    }
-  }
-}
-
 class IntrinsicsSolver {
  public:
   IntrinsicsSolver(const BundleAdjustmentProblem& problem, const PinholeCamera& camera,
@@ -159,9 +142,6 @@ class IntrinsicsSolver {
 
     result.rms_before = rms_fixed;
     result.rms_after = rms_refined;
-    result.focal_scale = intrinsics_[0];
-    result.intrinsics = refinedIntrinsics();
-    result.estimate = result.intrinsics;
     const double gain = rms_fixed > 0.0 ? 1.0 - rms_refined / rms_fixed : 0.0;
     const double given_k1 = input_camera_intrinsics_.distortion.k1;
     const double given_k2 = input_camera_intrinsics_.distortion.k2;
@@ -184,13 +164,13 @@ class IntrinsicsSolver {
         removeOutliers();
         if (!solve(result)) return abandoned(result);
       }
-      result.intrinsics = refinedIntrinsics();
-      result.estimate = result.intrinsics;
-      result.focal_scale = intrinsics_[0];
     }
+    // After the last solve when adopted: the refined values; otherwise what the data asked for.
+    result.focal_scale = intrinsics_[0];
+    result.estimate = refinedIntrinsics();
+    result.intrinsics = result.adopted ? result.estimate : input_camera_intrinsics_;
     for (const ceres::ResidualBlockId id : residual_ids_) result.inliers += id != nullptr ? 1 : 0;
     result.outliers = input_.observations.size() - result.inliers;
-    if (!result.adopted) result.intrinsics = input_camera_intrinsics_;
     const auto& poses = result.adopted ? poses_ : poses_fixed;
     const auto& points = result.adopted ? points_ : points_fixed;
     for (const PoseBlock& pose : poses) result.T_cw.push_back(fromPoseBlock(pose));
@@ -367,8 +347,9 @@ class IntrinsicsSolver {
 
 }  // namespace
 
-std::optional<IntrinsicsRefinementOptions> parseRefinedIntrinsics(std::string_view spec) {
-  IntrinsicsRefinementOptions options;
+std::optional<IntrinsicsRefinementOptions> parseRefinedIntrinsics(
+    std::string_view spec, IntrinsicsRefinementOptions base) {
+  IntrinsicsRefinementOptions options = std::move(base);
   options.refine_focal = options.refine_k1 = options.refine_k2 = false;
   if (spec == "off") return options;
   while (true) {
@@ -392,7 +373,13 @@ bool refinesAnything(const IntrinsicsRefinementOptions& options) {
 IntrinsicsRefinementResult refineIntrinsics(const BundleAdjustmentProblem& problem,
                                             const PinholeCamera& camera,
                                             const IntrinsicsRefinementOptions& options) {
-  validate(problem, options);
+  validateBundleAdjustmentProblem(problem, "refineIntrinsics");
+  if (!refinesAnything(options)) {
+    throw std::invalid_argument("refineIntrinsics: nothing to refine (focal, k1 and k2 all off)");
+  }
+  if (options.iterations <= 0) {
+    throw std::invalid_argument("refineIntrinsics: iterations must be positive");
+  }
   std::size_t free_keyframes = 0;
   for (const BAKeyFrame& kf : problem.keyframes) free_keyframes += kf.fixed ? 0 : 1;
   if (free_keyframes < options.min_keyframes) {

@@ -55,9 +55,10 @@ struct IntrinsicsRefinementResult {
   std::vector<Eigen::Vector3d> points;  // per problem point
 };
 
-// "off", or a comma-separated set of focal, k1, k2 (e.g. "focal,k1"); nullopt when malformed.
-// The other options keep their defaults.
-std::optional<IntrinsicsRefinementOptions> parseRefinedIntrinsics(std::string_view spec);
+// "off", or a comma-separated set of focal, k1, k2 (e.g. "focal,k1"): `base` with those refined
+// and the others not; nullopt when malformed.
+std::optional<IntrinsicsRefinementOptions> parseRefinedIntrinsics(
+    std::string_view spec, IntrinsicsRefinementOptions base = {});
 bool refinesAnything(const IntrinsicsRefinementOptions& options);
 
 // Throws std::invalid_argument for a malformed problem (as bundleAdjust does) or options.

@@ -19,10 +19,13 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-void validate(const BundleAdjustmentProblem& problem) {
+}  // namespace
+
+void validateBundleAdjustmentProblem(const BundleAdjustmentProblem& problem,
+                                     const std::string& caller) {
   problem.camera.validate();
-  const auto fail = [](const std::string& what) {
-    throw std::invalid_argument("bundleAdjust: " + what);
+  const auto fail = [&caller](const std::string& what) {
+    throw std::invalid_argument(caller + ": " + what);
   };
   for (std::size_t i = 0; i < problem.keyframes.size(); ++i) {
     const SE3d& T = problem.keyframes[i].T_cw;
@@ -55,6 +58,8 @@ void validate(const BundleAdjustmentProblem& problem) {
     }
   }
 }
+
+namespace {
 
 class BundleSolver {
  public:
@@ -259,7 +264,7 @@ class BundleSolver {
 
 BundleAdjustmentResult bundleAdjust(const BundleAdjustmentProblem& problem,
                                     const BundleAdjustmentOptions& options) {
-  validate(problem);
+  validateBundleAdjustmentProblem(problem, "bundleAdjust");
   return BundleSolver(problem, options).run();
 }
 

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "geometry/se3.h"
@@ -84,6 +85,11 @@ struct BundleAdjustmentResult {
   double rms_before = 0.0;
   double rms_after = 0.0;
 };
+
+// Throws std::invalid_argument, prefixed with `caller`, naming the bad keyframe / point /
+// observation.
+void validateBundleAdjustmentProblem(const BundleAdjustmentProblem& problem,
+                                     const std::string& caller);
 
 // Throws std::invalid_argument naming the bad keyframe / point / observation.
 BundleAdjustmentResult bundleAdjust(const BundleAdjustmentProblem& problem,

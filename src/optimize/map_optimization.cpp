@@ -1,5 +1,7 @@
 #include "optimize/map_optimization.h"
 
+#include <fmt/format.h>
+
 #include <unordered_map>
 
 #include "util/timing_stats.h"
@@ -65,6 +67,22 @@ ProblemBuild buildProblem(const std::vector<KeyFrame*>& free_keyframes, KeyFrame
   return build;
 }
 
+// The solved poses of the free keyframes and the solved points into the map (its update mutex
+// held by the caller).
+void writeBack(Map& map, const ProblemBuild& build, const std::vector<SE3d>& T_cw,
+               const std::vector<Eigen::Vector3d>& points) {
+  for (std::size_t k = 0; k < build.keyframes.size(); ++k) {
+    if (build.problem.keyframes[k].fixed || build.keyframes[k]->isBad()) continue;
+    map.setKeyFramePose(build.keyframes[k], T_cw[k]);
+  }
+  for (std::size_t i = 0; i < build.points.size(); ++i) {
+    MapPoint* p = build.points[i];
+    if (p->isBad()) continue;
+    map.setPointPosition(p, points[i]);
+    map.refreshPoint(p);
+  }
+}
+
 LocalBundleAdjustmentStats solveAndApply(Map& map, ProblemBuild build,
                                          const BundleAdjustmentOptions& options) {
   LocalBundleAdjustmentStats stats;
@@ -90,16 +108,7 @@ LocalBundleAdjustmentStats solveAndApply(Map& map, ProblemBuild build,
       ++stats.outliers_removed;
     }
   }
-  for (std::size_t k = 0; k < build.keyframes.size(); ++k) {
-    if (build.problem.keyframes[k].fixed || build.keyframes[k]->isBad()) continue;
-    map.setKeyFramePose(build.keyframes[k], result.T_cw[k]);
-  }
-  for (std::size_t i = 0; i < build.points.size(); ++i) {
-    MapPoint* p = build.points[i];
-    if (p->isBad()) continue;
-    map.setPointPosition(p, result.points[i]);
-    map.refreshPoint(p);
-  }
+  writeBack(map, build, result.T_cw, result.points);
   return stats;
 }
 
@@ -177,17 +186,22 @@ MapIntrinsicsRefinement refineMapIntrinsics(Map& map, const PinholeCamera& camer
   out.solve_ms = timer.elapsedMs();
   if (!out.result.adopted) return out;
   std::lock_guard lock(map.updateMutex());
-  for (std::size_t k = 0; k < build.keyframes.size(); ++k) {
-    if (build.problem.keyframes[k].fixed || build.keyframes[k]->isBad()) continue;
-    map.setKeyFramePose(build.keyframes[k], out.result.T_cw[k]);
-  }
-  for (std::size_t i = 0; i < build.points.size(); ++i) {
-    MapPoint* p = build.points[i];
-    if (p->isBad()) continue;
-    map.setPointPosition(p, out.result.points[i]);
-    map.refreshPoint(p);
-  }
+  writeBack(map, build, out.result.T_cw, out.result.points);
   return out;
+}
+
+std::string describe(const MapIntrinsicsRefinement& refinement) {
+  const IntrinsicsRefinementResult& r = refinement.result;
+  if (!r.adopted) {
+    return fmt::format("kept: {} ({:.0f} ms over {} keyframes)", r.reason, refinement.solve_ms,
+                       refinement.keyframes);
+  }
+  const CameraIntrinsics& in = r.intrinsics;
+  return fmt::format(
+      "refined fx {:.2f} fy {:.2f} k1 {:.4f} k2 {:.4f}, reprojection RMS {:.3f} -> {:.3f} px "
+      "({:.0f} ms over {} keyframes)",
+      in.fx, in.fy, in.distortion.k1, in.distortion.k2, r.rms_before, r.rms_after,
+      refinement.solve_ms, refinement.keyframes);
 }
 
 }  // namespace edgeslam

@@ -4,6 +4,7 @@
 // update mutex: these take it to read the problem and to write the result back, and solve unlocked.
 #include <atomic>
 #include <cstddef>
+#include <string>
 
 #include "geometry/camera.h"
 #include "map/frame.h"
@@ -54,6 +55,9 @@ struct MapIntrinsicsRefinement {
 // poses and point positions; the keyframes' keypoints stay undistorted with `camera`, so this is
 // for a finished map (the end of a run), whose refined camera the caller reports. Same locking as
 // above.
+// One line for logs and summaries: the refined values and the RMS, or why they were kept.
+std::string describe(const MapIntrinsicsRefinement& refinement);
+
 MapIntrinsicsRefinement refineMapIntrinsics(Map& map, const PinholeCamera& camera,
                                             const IntrinsicsRefinementOptions& options = {});
 

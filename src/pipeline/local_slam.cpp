@@ -79,19 +79,9 @@ void LocalSlam::finish() {
 
 void LocalSlam::refineIntrinsicsOfTheMap() {
   // The map is complete and the mapper idle: nothing else changes it while this runs.
+  spdlog::info("self-calibration over {} keyframes...", map_.keyFrameCount());
   intrinsics_refinement_ = refineMapIntrinsics(map_, camera_, options_.intrinsics_refinement);
-  const IntrinsicsRefinementResult& r = intrinsics_refinement_->result;
-  const Distortion& d = r.intrinsics.distortion;
-  if (r.adopted) {
-    spdlog::info(
-        "intrinsics refined over {} keyframes: fx {:.2f} fy {:.2f} k1 {:.4f} k2 {:.4f}, "
-        "reprojection RMS {:.4f} -> {:.4f} px ({} iterations, {:.0f} ms)",
-        intrinsics_refinement_->keyframes, r.intrinsics.fx, r.intrinsics.fy, d.k1, d.k2,
-        r.rms_before, r.rms_after, r.iterations, intrinsics_refinement_->solve_ms);
-  } else {
-    spdlog::info("intrinsics kept: {} (refined RMS {:.4f} against {:.4f} px, {:.0f} ms)", r.reason,
-                 r.rms_after, r.rms_before, intrinsics_refinement_->solve_ms);
-  }
+  spdlog::info("intrinsics {}", describe(*intrinsics_refinement_));
 }
 
 SlamCounters LocalSlam::counters() const {
