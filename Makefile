@@ -2,6 +2,7 @@
 SHELL := /bin/bash
 BUILD_DIR ?= build
 ASAN_DIR ?= build-asan
+TSAN_DIR ?= build-tsan
 BUILD_TYPE ?= Release
 WERROR ?= ON
 JOBS ?= $(shell nproc)
@@ -11,7 +12,7 @@ DEMO_OUT ?= out/demo
 DEMO_ARGS ?=
 export EDGESLAM_SHARED
 
-.PHONY: all deps configure build vocab test test-release test-sanitize test-host-timing demo bench format format-check clean
+.PHONY: all deps configure build vocab test test-release test-sanitize test-tsan test-host-timing demo bench format format-check clean
 
 all: build
 
@@ -54,8 +55,18 @@ test-sanitize: deps
 	@cmake --build $(ASAN_DIR) -j $(JOBS)
 	@cd $(ASAN_DIR) && ctest --output-on-failure -j $(JOBS) -L unit --timeout 900
 
+# The clang build: -Wthread-safety checks the lock annotations at compile time (warnings are
+# errors), and ThreadSanitizer watches the unit tests run. -O1 with line tables only keeps it quick.
+test-tsan: deps
+	@CC=clang CXX=clang++ cmake -S . -B $(TSAN_DIR) -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" -DEDGESLAM_WERROR=$(WERROR) \
+	  -DEDGESLAM_TSAN=ON -DEDGESLAM_BUILD_BENCH=OFF -DEDGESLAM_SHARED_DIR=$(EDGESLAM_SHARED) > /dev/null
+	@cmake --build $(TSAN_DIR) -j $(JOBS)
+	@cd $(TSAN_DIR) && TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$(CURDIR)/tests/tsan.supp" \
+	  ctest --output-on-failure -j $(JOBS) -L unit --timeout 900
+
 test: test-release
-	@if [ -n "$$CI" ]; then $(MAKE) --no-print-directory test-sanitize; fi
+	@if [ -n "$$CI" ]; then $(MAKE) --no-print-directory test-sanitize test-tsan; fi
 
 demo: vocab
 	@./$(BUILD_DIR)/edgeslam run --dataset "$(EDGESLAM_DATA)" --mode edge --out $(DEMO_OUT) $(DEMO_ARGS)

@@ -32,7 +32,7 @@ AdaptationController::AdaptationController(AdaptationOptions options)
 }
 
 bool AdaptationController::onLatencyProbe(double rtt_ms, std::size_t wire_bytes) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   probe_bytes_ += wire_bytes;
   estimator_.addLatencyProbe(rtt_ms);
   return reevaluateLocked();
@@ -40,7 +40,7 @@ bool AdaptationController::onLatencyProbe(double rtt_ms, std::size_t wire_bytes)
 
 bool AdaptationController::onBandwidthProbe(std::size_t payload_bytes, double elapsed_ms,
                                             std::size_t wire_bytes) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   probe_bytes_ += wire_bytes;
   if (!estimator_.addBandwidthProbe(payload_bytes, elapsed_ms)) return false;
   return reevaluateLocked();
@@ -50,12 +50,12 @@ void AdaptationController::setMessageBytes(double message_bytes) {
   if (!(message_bytes >= 0.0)) {
     throw std::invalid_argument(fmt::format("message size {} bytes is invalid", message_bytes));
   }
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   options_.message_bytes = message_bytes;
 }
 
 bool AdaptationController::observe(double n_ms) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   return observeLocked(n_ms);
 }
 
@@ -102,42 +102,42 @@ bool AdaptationController::observeLocked(double n_ms) {
 }
 
 KeyframeConfig AdaptationController::config() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   return adaptationTable()[row_].config;
 }
 
 std::size_t AdaptationController::row() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   return row_;
 }
 
 std::optional<double> AdaptationController::lastNetworkTimeMs() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   return last_n_ms_;
 }
 
 NetworkEstimator AdaptationController::estimator() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   return estimator_;
 }
 
 void AdaptationController::onFrame() {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   ++frames_[row_];
 }
 
 std::uint64_t AdaptationController::switches() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   return switches_;
 }
 
 std::array<std::uint64_t, kAdaptationRows> AdaptationController::framesPerConfig() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   return frames_;
 }
 
 std::uint64_t AdaptationController::probeBytes() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   return probe_bytes_;
 }
 

@@ -11,11 +11,11 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
-#include <mutex>
 #include <optional>
 
 #include "adapt/keyframe_config.h"
 #include "adapt/network_estimator.h"
+#include "util/mutex.h"
 
 namespace edgeslam {
 
@@ -55,20 +55,20 @@ class AdaptationController {
   std::uint64_t probeBytes() const;
 
  private:
-  bool observeLocked(double n_ms);
-  bool reevaluateLocked();
+  bool observeLocked(double n_ms) REQUIRES(mutex_);
+  bool reevaluateLocked() REQUIRES(mutex_);
   double marginMs(double boundary_ms) const;
 
   AdaptationOptions options_;
-  mutable std::mutex mutex_;
-  NetworkEstimator estimator_;
-  std::size_t row_;
-  bool has_estimate_ = false;
-  int outside_count_ = 0;
-  std::optional<double> last_n_ms_;
-  std::uint64_t switches_ = 0;
-  std::array<std::uint64_t, kAdaptationRows> frames_{};
-  std::uint64_t probe_bytes_ = 0;
+  mutable Mutex mutex_;
+  NetworkEstimator estimator_ GUARDED_BY(mutex_);
+  std::size_t row_ GUARDED_BY(mutex_);
+  bool has_estimate_ GUARDED_BY(mutex_) = false;
+  int outside_count_ GUARDED_BY(mutex_) = 0;
+  std::optional<double> last_n_ms_ GUARDED_BY(mutex_);
+  std::uint64_t switches_ GUARDED_BY(mutex_) = 0;
+  std::array<std::uint64_t, kAdaptationRows> frames_ GUARDED_BY(mutex_){};
+  std::uint64_t probe_bytes_ GUARDED_BY(mutex_) = 0;
 };
 
 }  // namespace edgeslam

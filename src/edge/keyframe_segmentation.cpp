@@ -18,7 +18,7 @@ KeyFrameSegmentationWorker::~KeyFrameSegmentationWorker() {
 }
 
 void KeyFrameSegmentationWorker::submit(KeyFrameSegmentationJob job) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   if (stopping_) return;
   queue_.push_back(std::move(job));
   while (queue_.size() > max_queued_) {
@@ -29,18 +29,18 @@ void KeyFrameSegmentationWorker::submit(KeyFrameSegmentationJob job) {
 }
 
 void KeyFrameSegmentationWorker::setNmsThreshold(float nm) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   pending_nms_ = nm;
 }
 
 void KeyFrameSegmentationWorker::waitUntilIdle() {
-  std::unique_lock lock(mutex_);
-  idle_.wait(lock, [&] { return stopping_ || (queue_.empty() && !busy_); });
+  MutexLock lock(mutex_);
+  lock.wait(idle_, [&]() REQUIRES(mutex_) { return stopping_ || (queue_.empty() && !busy_); });
 }
 
 void KeyFrameSegmentationWorker::stop() {
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     stopping_ = true;
     wake_.notify_all();
     idle_.notify_all();
@@ -49,7 +49,7 @@ void KeyFrameSegmentationWorker::stop() {
 }
 
 KeyFrameSegmentationCounters KeyFrameSegmentationWorker::counters() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   return {segmented_, skipped_, failed_, segmentation_ms_.summary()};
 }
 
@@ -58,8 +58,8 @@ void KeyFrameSegmentationWorker::run() {
     KeyFrameSegmentationJob job;
     float nms = -1.f;
     {
-      std::unique_lock lock(mutex_);
-      wake_.wait(lock, [&] { return stopping_ || !queue_.empty(); });
+      MutexLock lock(mutex_);
+      lock.wait(wake_, [&]() REQUIRES(mutex_) { return stopping_ || !queue_.empty(); });
       if (stopping_) return;
       job = std::move(queue_.front());
       queue_.pop_front();
@@ -94,7 +94,7 @@ void KeyFrameSegmentationWorker::run() {
     }
     const double elapsed_ms = result.segmentation_ms;
     if (ok) done_(std::move(result));
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     busy_ = false;
     if (ok) {
       ++segmented_;

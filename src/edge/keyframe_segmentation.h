@@ -7,12 +7,12 @@
 #include <deque>
 #include <functional>
 #include <memory>
-#include <mutex>
 #include <opencv2/core.hpp>
 #include <thread>
 
 #include "map/ids.h"
 #include "semantic/segmenter.h"
+#include "util/mutex.h"
 #include "util/timing_stats.h"
 
 namespace edgeslam {
@@ -65,15 +65,17 @@ class KeyFrameSegmentationWorker {
   std::shared_ptr<Segmenter> segmenter_;
   Done done_;
   std::size_t max_queued_;
-  mutable std::mutex mutex_;
+  mutable Mutex mutex_;
   std::condition_variable wake_;
   std::condition_variable idle_;
-  std::deque<KeyFrameSegmentationJob> queue_;
-  bool busy_ = false;
-  bool stopping_ = false;
-  float pending_nms_ = -1.f;
-  std::size_t segmented_ = 0, skipped_ = 0, failed_ = 0;
-  SampleStats segmentation_ms_;
+  std::deque<KeyFrameSegmentationJob> queue_ GUARDED_BY(mutex_);
+  bool busy_ GUARDED_BY(mutex_) = false;
+  bool stopping_ GUARDED_BY(mutex_) = false;
+  float pending_nms_ GUARDED_BY(mutex_) = -1.f;
+  std::size_t segmented_ GUARDED_BY(mutex_) = 0;
+  std::size_t skipped_ GUARDED_BY(mutex_) = 0;
+  std::size_t failed_ GUARDED_BY(mutex_) = 0;
+  SampleStats segmentation_ms_ GUARDED_BY(mutex_);
   std::thread thread_;
 };
 

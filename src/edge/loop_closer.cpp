@@ -33,13 +33,16 @@ LoopCloser::~LoopCloser() {
 
 void LoopCloser::start() {
   if (!options_.threaded || thread_.joinable()) return;
-  stopping_ = false;
+  {
+    MutexLock lock(queue_mutex_);
+    stopping_ = false;
+  }
   thread_ = std::thread([this] { run(); });
 }
 
 void LoopCloser::stop() {
   {
-    std::lock_guard lock(queue_mutex_);
+    MutexLock lock(queue_mutex_);
     stopping_ = true;
   }
   queue_cv_.notify_all();
@@ -49,7 +52,7 @@ void LoopCloser::stop() {
 
 void LoopCloser::insertKeyFrame(KeyFrame* keyframe) {
   {
-    std::lock_guard lock(queue_mutex_);
+    MutexLock lock(queue_mutex_);
     queue_.push_back(keyframe);
   }
   queue_cv_.notify_one();
@@ -58,12 +61,12 @@ void LoopCloser::insertKeyFrame(KeyFrame* keyframe) {
 void LoopCloser::onMapReset() {
   reset_requested_ = true;
   cancel_global_ba_ = true;  // no join: the caller may hold the map mutex the run needs
-  std::lock_guard lock(queue_mutex_);
+  MutexLock lock(queue_mutex_);
   queue_.clear();
 }
 
 LoopCloserStats LoopCloser::stats() const {
-  std::lock_guard lock(stats_mutex_);
+  MutexLock lock(stats_mutex_);
   return stats_;
 }
 
@@ -75,7 +78,7 @@ void LoopCloser::processAll() {
   while (true) {
     KeyFrame* keyframe = nullptr;
     {
-      std::lock_guard lock(queue_mutex_);
+      MutexLock lock(queue_mutex_);
       if (queue_.empty()) return;
       keyframe = queue_.front();
       queue_.pop_front();
@@ -88,10 +91,10 @@ void LoopCloser::waitUntilIdle() {
   if (!options_.threaded || !thread_.joinable()) {
     if (!options_.threaded) processAll();
   } else {
-    std::unique_lock lock(queue_mutex_);
-    idle_cv_.wait(lock, [this] { return queue_.empty() && !busy_; });
+    MutexLock lock(queue_mutex_);
+    lock.wait(idle_cv_, [this]() REQUIRES(queue_mutex_) { return queue_.empty() && !busy_; });
   }
-  std::lock_guard lock(global_ba_mutex_);
+  MutexLock lock(global_ba_mutex_);
   if (global_ba_thread_.joinable()) global_ba_thread_.join();
 }
 
@@ -102,10 +105,11 @@ void LoopCloser::run() {
   while (true) {
     KeyFrame* keyframe = nullptr;
     {
-      std::unique_lock lock(queue_mutex_);
+      MutexLock lock(queue_mutex_);
       busy_ = false;
       idle_cv_.notify_all();
-      queue_cv_.wait(lock, [this] { return stopping_ || !queue_.empty(); });
+      lock.wait(queue_cv_,
+                [this]() REQUIRES(queue_mutex_) { return stopping_ || !queue_.empty(); });
       if (stopping_) return;
       keyframe = queue_.front();
       queue_.pop_front();
@@ -122,7 +126,7 @@ void LoopCloser::processKeyFrame(KeyFrame* keyframe) {
   }
   try {
     {
-      std::lock_guard lock(map_.updateMutex());
+      std::unique_lock lock(map_.updateMutex());
       if (keyframe->isBad()) return;
     }
     detector_.describe(*keyframe);  // the features never change: no lock needed
@@ -130,7 +134,7 @@ void LoopCloser::processKeyFrame(KeyFrame* keyframe) {
     LoopVerification verification;
     bool verified_any = false;
     {
-      std::lock_guard lock(map_.updateMutex());
+      std::unique_lock lock(map_.updateMutex());
       if (keyframe->isBad()) return;
       const bool search = map_.keyFrameCount() >= options_.min_map_keyframes &&
                           keyframes_since_loop_ > options_.min_keyframes_since_loop;
@@ -151,7 +155,7 @@ void LoopCloser::processKeyFrame(KeyFrame* keyframe) {
       }
     }
     {
-      std::lock_guard lock(stats_mutex_);
+      MutexLock lock(stats_mutex_);
       ++stats_.keyframes_processed;
       if (verified_any) ++stats_.keyframes_with_candidates;
     }
@@ -205,7 +209,7 @@ void LoopCloser::closeLoop(const VerifiedLoop& loop) {
       corrected.neighbourhood, corrected.points_replaced, corrected.new_links,
       corrected.graph_vertices, corrected.graph_edges, corrected.pose_graph_ms, elapsed_ms);
   {
-    std::lock_guard lock(stats_mutex_);
+    MutexLock lock(stats_mutex_);
     stats_.events.push_back(event);
     stats_.loops = stats_.events.size();
   }
@@ -215,7 +219,7 @@ void LoopCloser::closeLoop(const VerifiedLoop& loop) {
 }
 
 void LoopCloser::stopGlobalBundleAdjustment() {
-  std::lock_guard lock(global_ba_mutex_);
+  MutexLock lock(global_ba_mutex_);
   if (!global_ba_thread_.joinable()) return;
   cancel_global_ba_ = true;
   global_ba_thread_.join();
@@ -223,10 +227,10 @@ void LoopCloser::stopGlobalBundleAdjustment() {
 
 void LoopCloser::launchGlobalBundleAdjustment() {
   {
-    std::lock_guard lock(stats_mutex_);
+    MutexLock lock(stats_mutex_);
     ++stats_.global_ba_started;
   }
-  std::lock_guard lock(global_ba_mutex_);
+  MutexLock lock(global_ba_mutex_);
   cancel_global_ba_ = false;
   if (options_.threaded) {
     global_ba_thread_ = std::thread([this] { globalBundleAdjustment(); });
@@ -252,7 +256,7 @@ void LoopCloser::globalBundleAdjustment() {
   }
   const double elapsed_ms = timer.elapsedMs();
   {
-    std::lock_guard lock(stats_mutex_);
+    MutexLock lock(stats_mutex_);
     if (result.applied) {
       ++stats_.global_ba_applied;
       stats_.global_ba_ms.push_back(elapsed_ms);

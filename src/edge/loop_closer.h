@@ -11,7 +11,6 @@
 #include <deque>
 #include <functional>
 #include <memory>
-#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -23,6 +22,7 @@
 #include "map/map.h"
 #include "map/sensor.h"
 #include "place/vocabulary.h"
+#include "util/mutex.h"
 
 namespace edgeslam {
 
@@ -116,22 +116,22 @@ class LoopCloser {
   LoopDetector detector_;
   std::size_t keyframes_since_loop_ = 0;
 
-  mutable std::mutex queue_mutex_;
+  mutable Mutex queue_mutex_;
   std::condition_variable queue_cv_;
   std::condition_variable idle_cv_;
-  std::deque<KeyFrame*> queue_;
-  bool busy_ = false;
-  bool stopping_ = false;
+  std::deque<KeyFrame*> queue_ GUARDED_BY(queue_mutex_);
+  bool busy_ GUARDED_BY(queue_mutex_) = false;
+  bool stopping_ GUARDED_BY(queue_mutex_) = false;
   std::thread thread_;
   std::atomic<bool> reset_requested_{false};
 
-  std::mutex global_ba_mutex_;  // guards global_ba_thread_ (launched and joined from two threads)
-  std::thread global_ba_thread_;
+  Mutex global_ba_mutex_;  // guards global_ba_thread_ (launched and joined from two threads)
+  std::thread global_ba_thread_ GUARDED_BY(global_ba_mutex_);
   std::atomic<bool> cancel_global_ba_{false};
 
   std::atomic<std::size_t> loops_{0};
-  mutable std::mutex stats_mutex_;
-  LoopCloserStats stats_;
+  mutable Mutex stats_mutex_;
+  LoopCloserStats stats_ GUARDED_BY(stats_mutex_);
   std::function<void()> on_corrected_;
 };
 

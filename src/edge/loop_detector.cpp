@@ -20,7 +20,7 @@ LoopDetector::LoopDetector(std::shared_ptr<const Vocabulary> vocabulary,
 
 const KeyFrameBow& LoopDetector::describe(const KeyFrame& keyframe) {
   {
-    std::lock_guard lock(bow_mutex_);
+    MutexLock lock(bow_mutex_);
     if (const auto it = bows_.find(keyframe.id()); it != bows_.end()) return it->second;
   }
   KeyFrameBow bow;
@@ -33,18 +33,18 @@ const KeyFrameBow& LoopDetector::describe(const KeyFrame& keyframe) {
     const int levels_up = std::max(0, vocabulary_->levels() - options_.direct_index_depth);
     vocabulary_->transform(keyframe.features().descriptors, levels_up, bow.bow, bow.features);
   }
-  std::lock_guard lock(bow_mutex_);
+  MutexLock lock(bow_mutex_);
   return bows_.try_emplace(keyframe.id(), std::move(bow)).first->second;
 }
 
 const KeyFrameBow* LoopDetector::bowOf(KeyFrameId id) const {
-  std::lock_guard lock(bow_mutex_);
+  MutexLock lock(bow_mutex_);
   const auto it = bows_.find(id);
   return it == bows_.end() ? nullptr : &it->second;
 }
 
 void LoopDetector::clear() {
-  std::lock_guard lock(bow_mutex_);
+  MutexLock lock(bow_mutex_);
   bows_.clear();
   database_.clear();
   consistency_.reset();

@@ -7,7 +7,6 @@
 // consistent (loop_consistency.h) before they are handed on to geometric verification.
 #include <cstddef>
 #include <memory>
-#include <mutex>
 #include <unordered_map>
 #include <vector>
 
@@ -18,6 +17,7 @@
 #include "place/feature_vector.h"
 #include "place/keyframe_database.h"
 #include "place/vocabulary.h"
+#include "util/mutex.h"
 
 namespace edgeslam {
 
@@ -74,8 +74,8 @@ class LoopDetector {
 
   std::shared_ptr<const Vocabulary> vocabulary_;
   LoopDetectorOptions options_;
-  mutable std::mutex bow_mutex_;
-  std::unordered_map<KeyFrameId, KeyFrameBow> bows_;
+  mutable Mutex bow_mutex_;
+  std::unordered_map<KeyFrameId, KeyFrameBow> bows_ GUARDED_BY(bow_mutex_);
   KeyFrameDatabase database_;
   LoopConsistency consistency_;
 };

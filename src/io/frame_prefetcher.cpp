@@ -19,7 +19,7 @@ FramePrefetcher::FramePrefetcher(DatasetReader& reader, std::size_t count,
 
 FramePrefetcher::~FramePrefetcher() {
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     stopping_ = true;
   }
   changed_.notify_all();
@@ -30,8 +30,10 @@ void FramePrefetcher::run() {
   lowerCurrentThreadPriority(options_.thread_nice);
   for (std::size_t index = 0; index < count_; ++index) {
     {
-      std::unique_lock lock(mutex_);
-      changed_.wait(lock, [this] { return stopping_ || ready_.size() < options_.frames_ahead; });
+      MutexLock lock(mutex_);
+      lock.wait(changed_, [this]() REQUIRES(mutex_) {
+        return stopping_ || ready_.size() < options_.frames_ahead;
+      });
       if (stopping_) return;
     }
     PrefetchedFrame prefetched;
@@ -39,7 +41,7 @@ void FramePrefetcher::run() {
     try {
       prefetched.frame = reader_.load(index);
     } catch (...) {
-      std::lock_guard lock(mutex_);
+      MutexLock lock(mutex_);
       error_ = std::current_exception();
       changed_.notify_all();
       return;
@@ -47,7 +49,7 @@ void FramePrefetcher::run() {
     prefetched.load_ms =
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     {
-      std::lock_guard lock(mutex_);
+      MutexLock lock(mutex_);
       ready_.push_back(std::move(prefetched));
     }
     changed_.notify_all();
@@ -55,11 +57,11 @@ void FramePrefetcher::run() {
 }
 
 PrefetchedFrame FramePrefetcher::next() {
-  std::unique_lock lock(mutex_);
+  MutexLock lock(mutex_);
   if (handed_out_ >= count_) {
     throw std::out_of_range("frame prefetcher: all frames were handed out");
   }
-  changed_.wait(lock, [this] { return !ready_.empty() || error_ != nullptr; });
+  lock.wait(changed_, [this]() REQUIRES(mutex_) { return !ready_.empty() || error_ != nullptr; });
   if (ready_.empty()) std::rethrow_exception(error_);
   PrefetchedFrame out = std::move(ready_.front());
   ready_.pop_front();

@@ -6,10 +6,10 @@
 #include <cstddef>
 #include <deque>
 #include <exception>
-#include <mutex>
 #include <thread>
 
 #include "io/dataset.h"
+#include "util/mutex.h"
 
 namespace edgeslam {
 
@@ -44,12 +44,12 @@ class FramePrefetcher {
   DatasetReader& reader_;
   const std::size_t count_;
   const FramePrefetcherOptions options_;
-  std::mutex mutex_;
+  Mutex mutex_;
   std::condition_variable changed_;
-  std::deque<PrefetchedFrame> ready_;
-  std::exception_ptr error_;  // reading the frame after the ready ones failed
-  std::size_t handed_out_ = 0;
-  bool stopping_ = false;
+  std::deque<PrefetchedFrame> ready_ GUARDED_BY(mutex_);
+  std::exception_ptr error_ GUARDED_BY(mutex_);  // reading the frame after the ready ones failed
+  std::size_t handed_out_ GUARDED_BY(mutex_) = 0;
+  bool stopping_ GUARDED_BY(mutex_) = false;
   std::thread thread_;
 };
 

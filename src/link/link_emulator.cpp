@@ -25,12 +25,12 @@ LinkEmulator::~LinkEmulator() {
 }
 
 void LinkEmulator::start() {
-  std::lock_guard lifecycle(lifecycle_mutex_);
+  MutexLock lifecycle(lifecycle_mutex_);
   if (running_) return;
   listen_fd_ = listenTcp(options_.listen);
   port_ = localPort(listen_fd_.get());
   {
-    std::lock_guard lock(settings_mutex_);
+    MutexLock lock(settings_mutex_);
     trace_start_ = LinkClock::now();
   }
   stopping_ = false;
@@ -41,14 +41,14 @@ void LinkEmulator::start() {
 }
 
 void LinkEmulator::stop() {
-  std::lock_guard lifecycle(lifecycle_mutex_);
+  MutexLock lifecycle(lifecycle_mutex_);
   if (!running_) return;
   stopping_ = true;
   if (accept_thread_.joinable()) accept_thread_.join();
   listen_fd_.close();
   std::vector<std::unique_ptr<LinkConnection>> connections;
   {
-    std::lock_guard lock(connections_mutex_);
+    MutexLock lock(connections_mutex_);
     connections.swap(connections_);
   }
   for (auto& connection : connections) connection->abort();
@@ -59,18 +59,18 @@ void LinkEmulator::stop() {
 
 void LinkEmulator::setSettings(const LinkSettings& settings) {
   validate(settings);
-  std::lock_guard lock(settings_mutex_);
+  MutexLock lock(settings_mutex_);
   settings_ = settings;
 }
 
 void LinkEmulator::setTrace(std::optional<LinkTrace> trace) {
-  std::lock_guard lock(settings_mutex_);
+  MutexLock lock(settings_mutex_);
   trace_ = std::move(trace);
   trace_start_ = LinkClock::now();
 }
 
 LinkSettings LinkEmulator::currentSettings() const {
-  std::lock_guard lock(settings_mutex_);
+  MutexLock lock(settings_mutex_);
   if (!trace_) return settings_;
   const double elapsed_s = std::chrono::duration<double>(LinkClock::now() - trace_start_).count();
   return trace_->settingsAt(elapsed_s, settings_);
@@ -94,7 +94,7 @@ LinkStats LinkEmulator::stats() const {
   stats.connections_total = connections_total_.load();
   stats.connect_failures = connect_failures_.load();
   stats.lost_segments = lost_segments_.load();
-  std::lock_guard lock(connections_mutex_);
+  MutexLock lock(connections_mutex_);
   stats.connections_active = static_cast<std::uint64_t>(
       std::count_if(connections_.begin(), connections_.end(),
                     [](const auto& connection) { return !connection->finished(); }));
@@ -104,7 +104,7 @@ LinkStats LinkEmulator::stats() const {
 void LinkEmulator::reapFinished() {
   std::vector<std::unique_ptr<LinkConnection>> done;
   {
-    std::lock_guard lock(connections_mutex_);
+    MutexLock lock(connections_mutex_);
     auto finished = std::stable_partition(connections_.begin(), connections_.end(),
                                           [](const auto& c) { return !c->finished(); });
     std::move(finished, connections_.end(), std::back_inserter(done));
@@ -139,7 +139,7 @@ void LinkEmulator::acceptLoop() {
         options_.max_queue_bytes);
     connection->start();
     ++connections_total_;
-    std::lock_guard lock(connections_mutex_);
+    MutexLock lock(connections_mutex_);
     connections_.push_back(std::move(connection));
   }
 }

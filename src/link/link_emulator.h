@@ -7,7 +7,6 @@
 #include <atomic>
 #include <cstdint>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <string>
 #include <thread>
@@ -17,6 +16,7 @@
 #include "link/link_settings.h"
 #include "link/link_trace.h"
 #include "link/socket.h"
+#include "util/mutex.h"
 
 namespace edgeslam {
 
@@ -68,21 +68,21 @@ class LinkEmulator {
   LinkDirectionParams directionParams(bool up) const;
 
   LinkEmulatorOptions options_;
-  std::mutex lifecycle_mutex_;
+  Mutex lifecycle_mutex_;
   std::atomic<bool> running_{false};
   std::atomic<bool> stopping_{false};
   std::atomic<std::uint16_t> port_{0};
   SocketFd listen_fd_;
-  std::thread accept_thread_;
+  std::thread accept_thread_ GUARDED_BY(lifecycle_mutex_);
 
-  mutable std::mutex settings_mutex_;
-  LinkSettings settings_;
-  std::optional<LinkTrace> trace_;
-  LinkClock::time_point trace_start_;
+  mutable Mutex settings_mutex_;
+  LinkSettings settings_ GUARDED_BY(settings_mutex_);
+  std::optional<LinkTrace> trace_ GUARDED_BY(settings_mutex_);
+  LinkClock::time_point trace_start_ GUARDED_BY(settings_mutex_);
 
-  mutable std::mutex connections_mutex_;
-  std::vector<std::unique_ptr<LinkConnection>> connections_;
-  std::uint64_t next_connection_ = 0;
+  mutable Mutex connections_mutex_;
+  std::vector<std::unique_ptr<LinkConnection>> connections_ GUARDED_BY(connections_mutex_);
+  std::uint64_t next_connection_ = 0;  // the accept thread's alone
 
   std::atomic<std::uint64_t> bytes_up_{0};
   std::atomic<std::uint64_t> bytes_down_{0};

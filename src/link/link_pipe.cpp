@@ -51,7 +51,7 @@ void LinkPipe::start() {
 
 void LinkPipe::requestStop() {
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     stop_ = true;
   }
   data_ready_.notify_all();
@@ -74,9 +74,11 @@ void LinkPipe::readLoop() {
   std::vector<char> buffer(kMaxRead);
   while (true) {
     {
-      std::unique_lock lock(mutex_);
-      space_ready_.wait(lock, [&] { return stop_ || queued_bytes_ < max_queue_bytes_; });
-      space_ready_.wait_until(lock, model_.linkFreeAt() - kMaxBacklog, [&] { return stop_; });
+      MutexLock lock(mutex_);
+      lock.wait(space_ready_,
+                [&]() REQUIRES(mutex_) { return stop_ || queued_bytes_ < max_queue_bytes_; });
+      lock.waitUntil(space_ready_, model_.linkFreeAt() - kMaxBacklog,
+                     [&]() REQUIRES(mutex_) { return stop_; });
       if (stop_) return;
     }
     const std::size_t wanted = readSize(params_());
@@ -84,7 +86,7 @@ void LinkPipe::readLoop() {
     if (got < 0 && errno == EINTR) continue;
     const auto now = LinkClock::now();
     {
-      std::lock_guard lock(mutex_);
+      MutexLock lock(mutex_);
       if (stop_) return;
     }
     if (got < 0) {
@@ -92,13 +94,13 @@ void LinkPipe::readLoop() {
       return;
     }
     if (got == 0) {
-      std::lock_guard lock(mutex_);
+      MutexLock lock(mutex_);
       queue_.push_back({std::max(now, model_.lastDelivery()), {}, true});
       data_ready_.notify_all();
       return;
     }
     const auto segments = model_.schedule(static_cast<std::size_t>(got), now, params_());
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     std::size_t offset = 0;
     for (const ScheduledSegment& segment : segments) {
       queue_.push_back({segment.deliver_at, std::string(buffer.data() + offset, segment.bytes)});
@@ -111,16 +113,16 @@ void LinkPipe::readLoop() {
 }
 
 void LinkPipe::writeLoop() {
-  std::unique_lock lock(mutex_);
+  MutexLock lock(mutex_);
   std::string out;
   while (!stop_) {
     if (queue_.empty()) {
-      data_ready_.wait(lock);
+      lock.wait(data_ready_);
       continue;
     }
     const auto now = LinkClock::now();
     if (now < queue_.front().deliver_at) {
-      data_ready_.wait_until(lock, queue_.front().deliver_at);
+      lock.waitUntil(data_ready_, queue_.front().deliver_at);
       continue;
     }
     out.clear();

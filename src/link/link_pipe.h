@@ -7,11 +7,11 @@
 #include <cstdint>
 #include <deque>
 #include <functional>
-#include <mutex>
 #include <string>
 #include <thread>
 
 #include "link/link_direction_model.h"
+#include "util/mutex.h"
 
 namespace edgeslam {
 
@@ -55,12 +55,12 @@ class LinkPipe {
   std::size_t max_queue_bytes_;
   std::function<void()> on_failure_;
 
-  std::mutex mutex_;
+  Mutex mutex_;
   std::condition_variable data_ready_;   // writer waits for due chunks
   std::condition_variable space_ready_;  // reader waits for room in the queue
-  std::deque<Chunk> queue_;
-  std::size_t queued_bytes_ = 0;
-  bool stop_ = false;
+  std::deque<Chunk> queue_ GUARDED_BY(mutex_);
+  std::size_t queued_bytes_ GUARDED_BY(mutex_) = 0;
+  bool stop_ GUARDED_BY(mutex_) = false;
 
   std::atomic<int> running_threads_{0};
   std::thread reader_;

@@ -15,7 +15,7 @@ std::uint64_t SliceQueue::push(MapSlice slice) {
   auto message = std::make_shared<v1::MapSlice>();
   slice.sequence = 1;
   toProto(slice, message.get());
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   const std::uint64_t sequence = last_pushed_ + 1;
   message->set_sequence(sequence);
   const std::size_t bytes = message->ByteSizeLong();
@@ -36,12 +36,12 @@ std::uint64_t SliceQueue::push(MapSlice slice) {
 }
 
 std::uint64_t SliceQueue::acknowledged() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   return acknowledged_;
 }
 
 void SliceQueue::acknowledge(std::uint64_t sequence) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   sequence = std::min(sequence, last_pushed_);
   if (sequence <= acknowledged_) return;
   acknowledged_ = sequence;
@@ -60,14 +60,14 @@ void SliceQueue::dropFrontLocked(bool acknowledged) {
 
 SliceQueue::WaitResult SliceQueue::waitFrom(std::uint64_t from, std::chrono::milliseconds timeout) {
   const auto deadline = std::chrono::steady_clock::now() + timeout;
-  std::unique_lock lock(mutex_);
+  MutexLock lock(mutex_);
   from = std::max<std::uint64_t>(from, 1);
   if (from > last_pushed_ + 1) return {WaitStatus::kBeyondEnd, nullptr, 0};
   while (true) {
     // Slices the client already acknowledged are skipped; dropped unacknowledged ones are a gap.
     from = std::max(from, acknowledged_ + 1);
-    const auto ready = [&] { return closed_ || last_pushed_ >= from; };
-    if (!pushed_.wait_until(lock, deadline, ready)) return {WaitStatus::kTimeout, nullptr, 0};
+    const auto ready = [&]() REQUIRES(mutex_) { return closed_ || last_pushed_ >= from; };
+    if (!lock.waitUntil(pushed_, deadline, ready)) return {WaitStatus::kTimeout, nullptr, 0};
     if (closed_) return {WaitStatus::kClosed, nullptr, 0};
     if (from <= dropped_through_) return {WaitStatus::kGap, nullptr, 0};
     for (const Entry& entry : entries_) {
@@ -77,28 +77,28 @@ SliceQueue::WaitResult SliceQueue::waitFrom(std::uint64_t from, std::chrono::mil
 }
 
 void SliceQueue::close() {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   closed_ = true;
   pushed_.notify_all();
 }
 
 std::uint64_t SliceQueue::firstAvailable() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   return std::max(acknowledged_, dropped_through_) + 1;
 }
 
 std::uint64_t SliceQueue::lastPushed() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   return last_pushed_;
 }
 
 std::size_t SliceQueue::kept() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   return entries_.size();
 }
 
 std::uint64_t SliceQueue::droppedUnacknowledged() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   return dropped_count_;
 }
 

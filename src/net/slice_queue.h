@@ -9,10 +9,10 @@
 #include <cstdint>
 #include <deque>
 #include <memory>
-#include <mutex>
 
 #include "edgeslam/v1/map_records.pb.h"
 #include "net/slice_sink.h"
+#include "util/mutex.h"
 
 namespace edgeslam {
 
@@ -58,18 +58,19 @@ class SliceQueue final : public SliceSink {
     std::shared_ptr<const v1::MapSlice> slice;
     std::size_t bytes;
   };
-  void dropFrontLocked(bool acknowledged);
+  void dropFrontLocked(bool acknowledged) REQUIRES(mutex_);
 
   SliceQueueLimits limits_;
-  mutable std::mutex mutex_;
+  mutable Mutex mutex_;
   std::condition_variable pushed_;
-  std::deque<Entry> entries_;
-  std::size_t kept_bytes_ = 0;
-  std::uint64_t last_pushed_ = 0;
-  std::uint64_t acknowledged_ = 0;
-  std::uint64_t dropped_through_ = 0;  // highest sequence dropped before acknowledgement
-  std::uint64_t dropped_count_ = 0;
-  bool closed_ = false;
+  std::deque<Entry> entries_ GUARDED_BY(mutex_);
+  std::size_t kept_bytes_ GUARDED_BY(mutex_) = 0;
+  std::uint64_t last_pushed_ GUARDED_BY(mutex_) = 0;
+  std::uint64_t acknowledged_ GUARDED_BY(mutex_) = 0;
+  std::uint64_t dropped_through_ GUARDED_BY(mutex_) =
+      0;  // highest sequence dropped before acknowledgement
+  std::uint64_t dropped_count_ GUARDED_BY(mutex_) = 0;
+  bool closed_ GUARDED_BY(mutex_) = false;
 };
 
 }  // namespace edgeslam

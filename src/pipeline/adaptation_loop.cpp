@@ -53,10 +53,10 @@ AdaptationLoop::~AdaptationLoop() {
 }
 
 void AdaptationLoop::start() {
-  std::lock_guard lock(thread_mutex_);
+  MutexLock lock(thread_mutex_);
   if (thread_.joinable()) return;
   {
-    std::lock_guard wake_lock(wake_mutex_);
+    MutexLock wake_lock(wake_mutex_);
     if (stopping_) return;  // stopped before it ever ran
   }
   spdlog::info("adaptation {}: probing every {:g} s (latency) and {:g} s (bandwidth)",
@@ -66,9 +66,9 @@ void AdaptationLoop::start() {
 }
 
 void AdaptationLoop::stop() {
-  std::lock_guard lock(thread_mutex_);
+  MutexLock lock(thread_mutex_);
   {
-    std::lock_guard wake_lock(wake_mutex_);
+    MutexLock wake_lock(wake_mutex_);
     stopping_ = true;
   }
   wake_.notify_all();
@@ -80,7 +80,7 @@ void AdaptationLoop::setMessageBytes(double bytes) {
     throw std::invalid_argument(fmt::format("adaptation loop: message size {} bytes", bytes));
   }
   controller_.setMessageBytes(bytes);
-  std::lock_guard lock(state_mutex_);
+  MutexLock lock(state_mutex_);
   message_bytes_ = bytes;
 }
 
@@ -89,17 +89,17 @@ void AdaptationLoop::onFrame() {
 }
 
 KeyframeConfig AdaptationLoop::current() const {
-  std::lock_guard lock(state_mutex_);
+  MutexLock lock(state_mutex_);
   return current_;
 }
 
 std::size_t AdaptationLoop::row() const {
-  std::lock_guard lock(state_mutex_);
+  MutexLock lock(state_mutex_);
   return current_row_;
 }
 
 NetworkEstimates AdaptationLoop::estimates() const {
-  std::lock_guard lock(state_mutex_);
+  MutexLock lock(state_mutex_);
   NetworkEstimates out;
   out.latency_ms = estimator_.latencyMs();
   out.bandwidth_mbps = estimator_.bandwidthMbps();
@@ -112,7 +112,7 @@ AdaptationLoopCounters AdaptationLoop::counters() const {
   AdaptationLoopCounters out;
   out.switches = controller_.switches();
   out.frames_per_config = controller_.framesPerConfig();
-  std::lock_guard lock(state_mutex_);
+  MutexLock lock(state_mutex_);
   out.probe_bytes = probe_bytes_;
   out.probe_uplink_bytes = probe_uplink_bytes_;
   out.probe_downlink_bytes = probe_downlink_bytes_;
@@ -124,7 +124,7 @@ AdaptationLoopCounters AdaptationLoop::counters() const {
 
 void AdaptationLoop::run() {
   const auto origin = Clock::now();
-  std::unique_lock lock(wake_mutex_);
+  MutexLock lock(wake_mutex_);
   while (!stopping_) {
     lock.unlock();
     const double now_s = std::chrono::duration<double>(Clock::now() - origin).count();
@@ -150,10 +150,11 @@ void AdaptationLoop::run() {
     }
     lock.lock();
     if (!keep_probing) {
-      wake_.wait(lock, [this] { return stopping_; });
+      lock.wait(wake_, [this]() REQUIRES(wake_mutex_) { return stopping_; });
       break;
     }
-    wake_.wait_for(lock, options_.poll_interval, [this] { return stopping_; });
+    lock.waitFor(wake_, options_.poll_interval,
+                 [this]() REQUIRES(wake_mutex_) { return stopping_; });
   }
 }
 
@@ -164,7 +165,7 @@ AdaptationLoop::ProbeOutcome AdaptationLoop::timedProbe(std::size_t payload_byte
       probe_(payload_bytes, reply_bytes, options_.probe_timeout);
   const double elapsed_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
   const std::size_t wire = estimatedProbeWireBytes(payload_bytes, reply_bytes);
-  std::lock_guard lock(state_mutex_);
+  MutexLock lock(state_mutex_);
   probe_bytes_ += wire;
   if (!result) {
     ++failed_probes_;
@@ -183,7 +184,7 @@ void AdaptationLoop::probeLatency() {
   const std::size_t payload = options_.schedule.small_payload_bytes;
   const double rtt_ms = timedProbe(payload, payload).elapsed_ms;
   {
-    std::lock_guard lock(state_mutex_);
+    MutexLock lock(state_mutex_);
     ++latency_probes_;
     estimator_.addLatencyProbe(rtt_ms);
   }
@@ -198,7 +199,7 @@ void AdaptationLoop::probeLatency() {
 void AdaptationLoop::probeBandwidth() {
   std::optional<double> bandwidth;
   {
-    std::lock_guard lock(state_mutex_);
+    MutexLock lock(state_mutex_);
     bandwidth = estimator_.bandwidthMbps();
   }
   const std::size_t payload = scheduler_.sizedProbeBytes(bandwidth);
@@ -206,7 +207,7 @@ void AdaptationLoop::probeBandwidth() {
   const ProbeOutcome outcome = timedProbe(payload, reply);
   double elapsed_ms = outcome.elapsed_ms;
   {
-    std::lock_guard lock(state_mutex_);
+    MutexLock lock(state_mutex_);
     if (!outcome.answered) {
       // The link moved fewer than `payload` bytes in the whole timeout, on top of its latency
       // (which may itself be made of timeouts): B <= payload / timeout.
@@ -228,7 +229,7 @@ void AdaptationLoop::publishIfSwitched(bool switched) {
   const KeyframeConfig config = controller_.config();
   const std::size_t row = controller_.row();
   {
-    std::lock_guard lock(state_mutex_);
+    MutexLock lock(state_mutex_);
     current_ = config;
     current_row_ = row;
   }
@@ -240,7 +241,7 @@ void AdaptationLoop::logWouldBeRow() {
   if (!now.network_time_ms) return;
   const std::size_t row = adaptationRowFor(*now.network_time_ms);
   {
-    std::lock_guard lock(state_mutex_);
+    MutexLock lock(state_mutex_);
     if (logged_row_ == row) return;
     logged_row_ = row;
   }

@@ -14,7 +14,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
-#include <mutex>
 #include <optional>
 #include <thread>
 
@@ -23,6 +22,7 @@
 #include "adapt/network_estimator.h"
 #include "adapt/probe_scheduler.h"
 #include "net/edge_client.h"
+#include "util/mutex.h"
 
 namespace edgeslam {
 
@@ -111,25 +111,26 @@ class AdaptationLoop {
   AdaptationController controller_;
   ProbeScheduler scheduler_;
 
-  mutable std::mutex state_mutex_;  // guards what follows up to the counters
-  NetworkEstimator estimator_;      // mirrors the controller's, also fed with adapt off
-  double message_bytes_;
-  KeyframeConfig current_;
-  std::size_t current_row_;
-  std::optional<std::size_t> logged_row_;
-  std::uint64_t probe_bytes_ = 0;
-  std::uint64_t probe_uplink_bytes_ = 0;
-  std::uint64_t probe_downlink_bytes_ = 0;
-  std::uint64_t latency_probes_ = 0;
-  std::uint64_t bandwidth_probes_ = 0;
-  std::uint64_t failed_probes_ = 0;
+  mutable Mutex state_mutex_;  // guards what follows up to the counters
+  NetworkEstimator estimator_
+      GUARDED_BY(state_mutex_);  // mirrors the controller's, also fed with adapt off
+  double message_bytes_ GUARDED_BY(state_mutex_);
+  KeyframeConfig current_ GUARDED_BY(state_mutex_);
+  std::size_t current_row_ GUARDED_BY(state_mutex_);
+  std::optional<std::size_t> logged_row_ GUARDED_BY(state_mutex_);
+  std::uint64_t probe_bytes_ GUARDED_BY(state_mutex_) = 0;
+  std::uint64_t probe_uplink_bytes_ GUARDED_BY(state_mutex_) = 0;
+  std::uint64_t probe_downlink_bytes_ GUARDED_BY(state_mutex_) = 0;
+  std::uint64_t latency_probes_ GUARDED_BY(state_mutex_) = 0;
+  std::uint64_t bandwidth_probes_ GUARDED_BY(state_mutex_) = 0;
+  std::uint64_t failed_probes_ GUARDED_BY(state_mutex_) = 0;
   std::atomic<std::uint64_t> version_{0};
 
-  std::mutex thread_mutex_;  // start()/stop()
-  std::mutex wake_mutex_;
+  Mutex thread_mutex_;  // start()/stop()
+  Mutex wake_mutex_;
   std::condition_variable wake_;
-  bool stopping_ = false;  // guarded by wake_mutex_
-  std::thread thread_;
+  bool stopping_ GUARDED_BY(wake_mutex_) = false;
+  std::thread thread_ GUARDED_BY(thread_mutex_);
 };
 
 }  // namespace edgeslam

@@ -26,24 +26,33 @@ void GrpcEdgeLink::send(KeyFrameUpload upload) {
 }
 
 void GrpcEdgeLink::setSliceHandler(SliceHandler handler) {
-  std::lock_guard lock(handler_mutex_);
+  MutexLock lock(handler_mutex_);
   handler_ = std::move(handler);
 }
 
+// The handlers run outside the link's locks (edge_link.h): a handler that calls back into the
+// link, or takes its own locks, cannot deadlock against a send.
 void GrpcEdgeLink::deliver(MapSlice slice) {
-  std::lock_guard lock(handler_mutex_);
-  if (handler_) handler_(std::move(slice));
+  SliceHandler handler;
+  {
+    MutexLock lock(handler_mutex_);
+    handler = handler_;
+  }
+  if (handler) handler(std::move(slice));
 }
 
 void GrpcEdgeLink::setUploadDroppedHandler(UploadDroppedHandler handler) {
-  std::lock_guard lock(dropped_mutex_);
+  MutexLock lock(dropped_mutex_);
   dropped_handler_ = std::move(handler);
 }
 
 void GrpcEdgeLink::reportDropped(std::uint64_t sequence, KeyFrameId keyframe) {
-  // Serialises the reports (the sender's thread and the upload thread may both drop one).
-  std::lock_guard lock(dropped_mutex_);
-  if (dropped_handler_) dropped_handler_(sequence, keyframe);
+  UploadDroppedHandler handler;
+  {
+    MutexLock lock(dropped_mutex_);
+    handler = dropped_handler_;
+  }
+  if (handler) handler(sequence, keyframe);
 }
 
 EdgeLinkCounters GrpcEdgeLink::counters() const {

@@ -1,11 +1,11 @@
 #pragma once
 // The real split: keyframe uploads and map slices over gRPC to an edge server session.
 #include <memory>
-#include <mutex>
 #include <string>
 
 #include "net/edge_client.h"
 #include "pipeline/edge_link.h"
+#include "util/mutex.h"
 
 namespace edgeslam {
 
@@ -30,10 +30,10 @@ class GrpcEdgeLink : public EdgeLink {
   void deliver(MapSlice slice);
   void reportDropped(std::uint64_t sequence, KeyFrameId keyframe);
 
-  std::mutex handler_mutex_;
-  SliceHandler handler_;
-  std::mutex dropped_mutex_;
-  UploadDroppedHandler dropped_handler_;
+  Mutex handler_mutex_;
+  SliceHandler handler_ GUARDED_BY(handler_mutex_);
+  Mutex dropped_mutex_;
+  UploadDroppedHandler dropped_handler_ GUARDED_BY(dropped_mutex_);
   std::unique_ptr<EdgeClient> client_;
 };
 

@@ -20,19 +20,19 @@ InProcessEdgeLink::~InProcessEdgeLink() {
 
 void InProcessEdgeLink::send(KeyFrameUpload upload) {
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     queue_.push_back(std::move(upload));
   }
   cv_.notify_one();
 }
 
 void InProcessEdgeLink::setUploadDroppedHandler(UploadDroppedHandler handler) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   dropped_handler_ = std::move(handler);
 }
 
 EdgeLinkCounters InProcessEdgeLink::counters() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   EdgeLinkCounters out;
   out.uploads_dropped = uploads_dropped_;
   return out;
@@ -42,8 +42,8 @@ void InProcessEdgeLink::run() {
   while (true) {
     KeyFrameUpload upload;
     {
-      std::unique_lock lock(mutex_);
-      cv_.wait(lock, [this] { return closing_ || !queue_.empty(); });
+      MutexLock lock(mutex_);
+      lock.wait(cv_, [this]() REQUIRES(mutex_) { return closing_ || !queue_.empty(); });
       if (queue_.empty()) return;
       upload = std::move(queue_.front());
       queue_.pop_front();
@@ -60,14 +60,14 @@ void InProcessEdgeLink::run() {
     if (rejected) {
       UploadDroppedHandler report;
       {
-        std::lock_guard lock(mutex_);
+        MutexLock lock(mutex_);
         ++uploads_dropped_;
         report = dropped_handler_;
       }
       if (report) report(upload.sequence, upload.keyframe.id);
     }
     {
-      std::lock_guard lock(mutex_);
+      MutexLock lock(mutex_);
       busy_ = false;
     }
     drained_.notify_all();
@@ -75,15 +75,15 @@ void InProcessEdgeLink::run() {
 }
 
 void InProcessEdgeLink::flush() {
-  std::unique_lock lock(mutex_);
-  drained_.wait(lock, [this] { return queue_.empty() && !busy_; });
+  MutexLock lock(mutex_);
+  lock.wait(drained_, [this]() REQUIRES(mutex_) { return queue_.empty() && !busy_; });
   lock.unlock();
   session_->finish();
 }
 
 void InProcessEdgeLink::close() {
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     if (closing_) return;
     closing_ = true;
   }

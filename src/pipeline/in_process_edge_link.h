@@ -5,11 +5,11 @@
 #include <condition_variable>
 #include <deque>
 #include <memory>
-#include <mutex>
 #include <thread>
 
 #include "edge/edge_map_session.h"
 #include "pipeline/edge_link.h"
+#include "util/mutex.h"
 
 namespace edgeslam {
 
@@ -36,12 +36,12 @@ class InProcessEdgeLink : public EdgeLink {
   SliceHandler handler_;
   UploadDroppedHandler dropped_handler_;  // guarded by mutex_
   std::uint64_t uploads_dropped_ = 0;     // guarded by mutex_
-  mutable std::mutex mutex_;
+  mutable Mutex mutex_;
   std::condition_variable cv_;
   std::condition_variable drained_;
-  bool busy_ = false;
-  std::deque<KeyFrameUpload> queue_;
-  bool closing_ = false;
+  bool busy_ GUARDED_BY(mutex_) = false;
+  std::deque<KeyFrameUpload> queue_ GUARDED_BY(mutex_);
+  bool closing_ GUARDED_BY(mutex_) = false;
   std::thread worker_;
 };
 

@@ -18,7 +18,7 @@ BowVector normalised(const BowVector& bow) {
 
 void KeyFrameDatabase::add(ImageId id, const BowVector& bow) {
   BowVector stored = normalised(bow);
-  const std::unique_lock lock(mutex_);
+  const WriterLock lock(mutex_);
   eraseLocked(id);
   for (const BowEntry& e : stored) {
     if (e.word >= postings_.size()) postings_.resize(static_cast<std::size_t>(e.word) + 1);
@@ -28,7 +28,7 @@ void KeyFrameDatabase::add(ImageId id, const BowVector& bow) {
 }
 
 void KeyFrameDatabase::erase(ImageId id) {
-  const std::unique_lock lock(mutex_);
+  const WriterLock lock(mutex_);
   eraseLocked(id);
 }
 
@@ -42,23 +42,23 @@ void KeyFrameDatabase::eraseLocked(ImageId id) {
 }
 
 void KeyFrameDatabase::clear() {
-  const std::unique_lock lock(mutex_);
+  const WriterLock lock(mutex_);
   postings_.clear();
   images_.clear();
 }
 
 std::size_t KeyFrameDatabase::size() const {
-  const std::shared_lock lock(mutex_);
+  const ReaderLock lock(mutex_);
   return images_.size();
 }
 
 bool KeyFrameDatabase::contains(ImageId id) const {
-  const std::shared_lock lock(mutex_);
+  const ReaderLock lock(mutex_);
   return images_.contains(id);
 }
 
 std::optional<BowVector> KeyFrameDatabase::bowOf(ImageId id) const {
-  const std::shared_lock lock(mutex_);
+  const ReaderLock lock(mutex_);
   const auto it = images_.find(id);
   if (it == images_.end()) return std::nullopt;
   return it->second;
@@ -84,7 +84,7 @@ std::vector<SharedWordsCandidate> KeyFrameDatabase::candidatesSharingWords(
     const BowVector& query, const std::unordered_set<ImageId>& exclude) const {
   std::vector<SharedWordsCandidate> candidates;
   {
-    const std::shared_lock lock(mutex_);
+    const ReaderLock lock(mutex_);
     for (const auto& [id, a] : accumulate(normalised(query), exclude)) {
       candidates.push_back({id, a.shared_words});
     }
@@ -96,7 +96,7 @@ std::vector<SharedWordsCandidate> KeyFrameDatabase::candidatesSharingWords(
 }
 
 std::optional<double> KeyFrameDatabase::score(const BowVector& query, ImageId id) const {
-  const std::shared_lock lock(mutex_);
+  const ReaderLock lock(mutex_);
   const auto it = images_.find(id);
   if (it == images_.end()) return std::nullopt;
   return l1Score(normalised(query), it->second);
@@ -107,7 +107,7 @@ std::vector<PlaceQueryResult> KeyFrameDatabase::query(
     const std::unordered_set<ImageId>& exclude) const {
   std::vector<PlaceQueryResult> results;
   {
-    const std::shared_lock lock(mutex_);
+    const ReaderLock lock(mutex_);
     for (const auto& [id, a] : accumulate(normalised(query), exclude)) {
       const double s = std::clamp(-0.5 * a.shared_term, 0.0, 1.0);
       if (s >= min_score) results.push_back({id, s, a.shared_words});

@@ -4,12 +4,12 @@
 // query image. Thread-safe: the mapper adds and erases while the tracker queries.
 #include <cstdint>
 #include <optional>
-#include <shared_mutex>
 #include <unordered_map>
 #include <unordered_set>
 #include <vector>
 
 #include "place/bow_vector.h"
+#include "util/mutex.h"
 
 namespace edgeslam {
 
@@ -64,13 +64,14 @@ class KeyFrameDatabase {
     double shared_term = 0.0;
   };
 
-  void eraseLocked(ImageId id);
+  void eraseLocked(ImageId id) REQUIRES(mutex_);
   std::unordered_map<ImageId, Accumulator> accumulate(
-      const BowVector& query, const std::unordered_set<ImageId>& exclude) const;
+      const BowVector& query, const std::unordered_set<ImageId>& exclude) const
+      REQUIRES_SHARED(mutex_);
 
-  mutable std::shared_mutex mutex_;
-  std::vector<std::vector<Posting>> postings_;  // by word id
-  std::unordered_map<ImageId, BowVector> images_;
+  mutable SharedMutex mutex_;
+  std::vector<std::vector<Posting>> postings_ GUARDED_BY(mutex_);  // by word id
+  std::unordered_map<ImageId, BowVector> images_ GUARDED_BY(mutex_);
 };
 
 }  // namespace edgeslam
