@@ -51,8 +51,9 @@ test-host-timing: build
 # The sanitizer build runs the fast unit tests only (label "unit"); CI runs it when CI is set.
 test-sanitize: deps
 	@cmake -S . -B $(ASAN_DIR) -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DEDGESLAM_WERROR=$(WERROR) \
-	  -DEDGESLAM_SANITIZE=ON -DEDGESLAM_SHARED_DIR=$(EDGESLAM_SHARED) > /dev/null
-	@cmake --build $(ASAN_DIR) -j $(JOBS)
+	  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DEDGESLAM_SANITIZE=ON \
+	  -DEDGESLAM_SHARED_DIR=$(EDGESLAM_SHARED) > /dev/null
+	@cmake --build $(ASAN_DIR) -j $(JOBS) --target unit-tests
 	@cd $(ASAN_DIR) && ctest --output-on-failure -j $(JOBS) -L unit --timeout 900
 
 # The clang build: -Wthread-safety checks the lock annotations at compile time (warnings are
@@ -61,7 +62,7 @@ test-tsan: deps
 	@CC=clang CXX=clang++ cmake -S . -B $(TSAN_DIR) -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
 	  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" -DEDGESLAM_WERROR=$(WERROR) \
 	  -DEDGESLAM_TSAN=ON -DEDGESLAM_BUILD_BENCH=OFF -DEDGESLAM_SHARED_DIR=$(EDGESLAM_SHARED) > /dev/null
-	@cmake --build $(TSAN_DIR) -j $(JOBS)
+	@cmake --build $(TSAN_DIR) -j $(JOBS) --target unit-tests
 	@cd $(TSAN_DIR) && TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$(CURDIR)/tests/tsan.supp" \
 	  ctest --output-on-failure -j $(JOBS) -L unit --timeout 900
 
