@@ -27,8 +27,10 @@ std::vector<std::string> runWarnings(const RunHealth& h, const RunWarningThresho
         h.backend_busy_refusals, h.tracked));
   }
   if (fraction(h.backend_wait_ms, h.wall_ms) > t.max_wait_fraction) {
-    out.push_back(fmt::format("tracking waited {:.1f} s of {:.1f} s for the back end",
-                              h.backend_wait_ms / 1000.0, h.wall_ms / 1000.0));
+    out.push_back(fmt::format(
+        "tracking waited {:.1f} s of {:.1f} s for the back end: the run is bound by mapping on "
+        "this machine (the map is a camera-paced run's; --realtime here would drop frames)",
+        h.backend_wait_ms / 1000.0, h.wall_ms / 1000.0));
   }
   if (h.monocular && h.keyframe_depth_ratio > 0.0 &&
       (h.keyframe_depth_ratio > t.max_depth_ratio ||
