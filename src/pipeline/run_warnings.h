@@ -26,8 +26,9 @@ struct RunWarningThresholds {
   double max_busy_fraction = 0.10;
   // Of the wall time: more and the run is bound by the back end (a hint, not an error).
   double max_wait_fraction = 0.50;
-  // Monocular: the scene's depth changing by more than this factor suggests scale drift.
-  double max_depth_ratio = 2.0;
+  // Monocular: the scene's depth changing by more than this factor suggests scale drift (KITTI 07
+  // edge runs that ended at 25-34 cm moved it by 1.7-2.3x: only gross drift is told).
+  double max_depth_ratio = 3.0;
 };
 
 std::vector<std::string> runWarnings(const RunHealth& health,

@@ -13,7 +13,7 @@ TEST(RunWarnings, NameWhatMadeTheRunWorse) {
   health.backend_wait_ms = 30'000.0;
   health.wall_ms = 40'000.0;
   health.monocular = true;
-  health.keyframe_depth_ratio = 0.36;
+  health.keyframe_depth_ratio = 0.3;
   const auto warnings = runWarnings(health);
   ASSERT_EQ(warnings.size(), 5u);
   EXPECT_NE(warnings[0].find("10 of 400 frames dropped"), std::string::npos) << warnings[0];
