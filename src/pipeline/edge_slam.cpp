@@ -22,7 +22,7 @@ EdgeSlam::EdgeSlam(const PinholeCamera& camera, SlamOptions options, std::unique
   link_->setUploadDroppedHandler(
       [this](std::uint64_t sequence, KeyFrameId keyframe) { onUploadDropped(sequence, keyframe); });
   options_.tracker.triangulate_at_keyframes = options_.client_triangulation;
-  startTracking(sink_.get());
+  startTracking(sink_.get(), [this] { waitForEdge(); });
   if (adaptation && link_->edgeClient() != nullptr) {
     adaptation_ = std::make_unique<AdaptationLoop>(*link_->edgeClient(), *adaptation);
     adaptation_->start();
@@ -202,6 +202,20 @@ void EdgeSlam::offerMask(const MaskRecord& mask) {
         decodeLabelImage(mask.bytes, mask.encoding, cv::Size(camera_.width(), camera_.height())));
   } catch (const std::exception& e) {
     spdlog::warn("mask of the keyframe of frame {} ignored: {}", frame_index, e.what());
+  }
+}
+
+void EdgeSlam::waitForEdge() {
+  // Bounded: an edge that stopped answering must not hang tracking (the link drops its uploads
+  // in time, which also ends the wait).
+  Stopwatch waited;
+  while (!sink_->allAnswered()) {
+    if (waited.elapsedMs() > kMaxEdgeWaitS * 1000.0) {
+      spdlog::warn("edge: keyframe upload unanswered after {:.0f} s; tracking goes on",
+                   kMaxEdgeWaitS);
+      return;
+    }
+    std::this_thread::sleep_for(std::chrono::microseconds(500));
   }
 }
 

@@ -54,6 +54,9 @@ class EdgeSlam : public TrackingSlam {
   void onUploadDropped(std::uint64_t sequence, KeyFrameId keyframe);
   void offerMask(const MaskRecord& mask);
   void afterFrame() override;
+  // --fast: until the edge has answered every keyframe upload (at most kMaxEdgeWaitS).
+  void waitForEdge();
+  static constexpr double kMaxEdgeWaitS = 10.0;
   void beforeTracking(std::size_t frame_index, const cv::Mat& image) override;
   void applyConfiguration(const KeyframeConfig& config);
   void noteClientMapSize(std::size_t keyframes, std::size_t points);

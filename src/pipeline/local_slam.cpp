@@ -34,7 +34,10 @@ LocalSlam::LocalSlam(const PinholeCamera& camera, SlamOptions options)
         options_.segmenter,
         [this](KeyFrameSegmentationResult result) { onSegmented(std::move(result)); });
   }
-  startTracking(mapper_.get());
+  startTracking(mapper_.get(), [this] {
+    mapper_->waitUntilIdle();
+    if (segmentation_) segmentation_->waitUntilIdle();
+  });
   if (options_.threaded_mapping) mapper_->start();
 }
 

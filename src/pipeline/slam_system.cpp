@@ -51,8 +51,37 @@ TrackingSlam::TrackingSlam(const PinholeCamera& camera, SlamOptions options,
   }
 }
 
-void TrackingSlam::startTracking(KeyFrameSink* sink) {
+void TrackingSlam::startTracking(KeyFrameSink* sink, std::function<void()> wait_until_idle) {
+  if (sink != nullptr) {
+    paced_sink_ = std::make_unique<PacedKeyFrameSink>(
+        *sink, options_.wait_for_backend ? std::move(wait_until_idle) : std::function<void()>());
+    sink = paced_sink_.get();
+  }
   tracker_ = std::make_unique<Tracker>(map_, camera_, options_.tracker, sink);
+}
+
+void TrackingSlam::noteKeyFrameDepth(KeyFrameId id) {
+  std::vector<double> depths;
+  {
+    std::lock_guard lock(map_.updateMutex());
+    const KeyFrame* keyframe = map_.keyFrame(id);
+    if (keyframe == nullptr) return;
+    const SE3d& T_cw = keyframe->pose();
+    for (const MapPoint* p : keyframe->goodPoints()) {
+      const double z = (T_cw * p->position()).z();
+      if (z > 0.0) depths.push_back(z);
+    }
+  }
+  if (depths.size() >= kMinPointsForDepth) keyframe_depths_.push_back(percentile(depths, 0.5));
+}
+
+double TrackingSlam::keyFrameDepthRatio() const {
+  const std::size_t quarter = keyframe_depths_.size() / 4;
+  if (quarter < kMinKeyFramesPerQuarter) return 0.0;
+  const std::vector<double> early(keyframe_depths_.begin(), keyframe_depths_.begin() + quarter);
+  const std::vector<double> late(keyframe_depths_.end() - quarter, keyframe_depths_.end());
+  const double early_depth = percentile(early, 0.5);
+  return early_depth > 0.0 ? percentile(late, 0.5) / early_depth : 0.0;
 }
 
 TrackResult TrackingSlam::process(std::size_t frame_index, double timestamp, const cv::Mat& gray,
@@ -83,6 +112,10 @@ TrackResult TrackingSlam::process(std::size_t frame_index, double timestamp, con
   stage = Stopwatch();
   afterTracking(result, frame_index, image);
   afterFrame();
+  if (options_.sensor == Sensor::kMonocular && result.new_keyframe &&
+      result.keyframe != kInvalidId) {
+    noteKeyFrameDepth(result.keyframe);
+  }
   last_stages_.keyframe_ms = stage.elapsedMs();
   keyframe_ms_.add(last_stages_.keyframe_ms);
   return result;
@@ -92,6 +125,8 @@ void TrackingSlam::addClientCounters(SlamCounters& counters) const {
   counters.features_ms = features_ms_.summary();
   counters.tracking_ms = tracking_ms_.summary();
   counters.keyframe_ms = keyframe_ms_.summary();
+  if (paced_sink_) counters.backend = paced_sink_->pacing();
+  counters.keyframe_depth_ratio = keyFrameDepthRatio();
   if (!semantic_filter_) return;
   const SemanticFilterCounters c = semantic_filter_->counters();
   counters.semantic_client_ms = semantic_ms_.summary();

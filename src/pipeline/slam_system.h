@@ -3,6 +3,7 @@
 // client's map, the trajectories and the counters. Modes differ in where keyframes go (local
 // mapping in-process, or the edge) and in what they count.
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <opencv2/core.hpp>
 #include <optional>
@@ -18,6 +19,7 @@
 #include "io/trajectory.h"
 #include "map/map.h"
 #include "optimize/map_optimization.h"
+#include "pipeline/paced_keyframe_sink.h"
 #include "place/vocabulary.h"
 #include "semantic/segmenter.h"
 #include "util/timing_stats.h"
@@ -38,6 +40,10 @@ struct SlamOptions {
   // a frame is tracked before the background work (util/thread_priority.h). Worth it when frames
   // come at a camera's pace; with frames fed back to back the mapper would fall behind.
   int background_nice = 0;
+  // Frames fed back to back (`--fast`): tracking hands over a keyframe only once the back end (the
+  // local mapper and segmentation, or the edge) has finished the previous one, so the map does not
+  // depend on the machine's speed (pipeline/paced_keyframe_sink.h).
+  bool wait_for_backend = false;
   // Loop closing runs where the global map is mapped (local mode: in-process; edge mode: on the
   // edge) when a vocabulary is given and it is switched on.
   std::shared_ptr<const Vocabulary> vocabulary;
@@ -108,6 +114,12 @@ struct SlamCounters {
   PercentileSummary features_ms;  // ORB extraction, undistortion, depth lookup
   PercentileSummary tracking_ms;  // pose estimation and local-map tracking
   PercentileSummary keyframe_ms;  // keyframe insertion, upload and the rest of the frame
+  // How long tracking waited for the back end, and how often the back end refused keyframes.
+  BackendPacing backend;
+  // Monocular: median scene depth of the last quarter of the keyframes over that of the first
+  // quarter (0 when there are too few keyframes). Along a drive the scene's depth stays about the
+  // same, so a map whose scale drifts shows it here (a cheap hint, no ground truth needed).
+  double keyframe_depth_ratio = 0.0;
 };
 
 // Bytes over the link so far (zero in local mode).
@@ -197,7 +209,9 @@ class TrackingSlam : public SlamSystem {
 
  protected:
   TrackingSlam(const PinholeCamera& camera, SlamOptions options, std::uint8_t map_id_origin);
-  void startTracking(KeyFrameSink* sink);
+  // `wait_until_idle` blocks until the back end has taken and finished every keyframe given to it;
+  // tracking calls it before handing over the next keyframe when options_.wait_for_backend.
+  void startTracking(KeyFrameSink* sink, std::function<void()> wait_until_idle = {});
   // Before tracking a frame whose image is `image` (colour when given, else grey).
   virtual void beforeTracking(std::size_t /*frame_index*/, const cv::Mat& /*image*/) {}
   virtual void afterFrame() {}
@@ -220,6 +234,13 @@ class TrackingSlam : public SlamSystem {
   SampleStats features_ms_;
   SampleStats tracking_ms_;
   SampleStats keyframe_ms_;
+  void noteKeyFrameDepth(KeyFrameId id);
+  double keyFrameDepthRatio() const;
+  static constexpr std::size_t kMinPointsForDepth = 20;
+  static constexpr std::size_t kMinKeyFramesPerQuarter = 5;
+
+  std::unique_ptr<PacedKeyFrameSink> paced_sink_;
+  std::vector<double> keyframe_depths_;  // monocular: each keyframe's median point depth
 };
 
 }  // namespace edgeslam
