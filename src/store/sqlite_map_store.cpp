@@ -104,7 +104,9 @@ SqliteMapStore::SqliteMapStore(const std::filesystem::path& file, MapStoreAccess
     {
       SqliteStatement check(db_, "PRAGMA quick_check(1)");
       if (check.step() && check.columnText(0) != "ok") {
-        throw StoreError("damaged map store: " + check.columnText(0));
+        std::string finding = check.columnText(0);
+        std::replace(finding.begin(), finding.end(), '\n', ' ');
+        throw StoreError("the map store is damaged (malformed: " + finding + ")");
       }
     }
     prepareSchema(db_, writable);

@@ -24,7 +24,15 @@ std::string defaultMapName(const std::string& prefix) {
   gmtime_r(&now, &utc);
   char stamp[32];
   std::strftime(stamp, sizeof(stamp), "%Y%m%d-%H%M%S", &utc);
-  return prefix + "-" + stamp;
+  std::string name = prefix.empty() ? std::string("map") : prefix;
+  for (char& ch : name) {
+    const bool safe = (ch >= 'a' && ch <= 'z') || (ch >= 'A' && ch <= 'Z') ||
+                      (ch >= '0' && ch <= '9') || ch == '.' || ch == '_' || ch == '-';
+    if (!safe) ch = '_';
+  }
+  if (name.front() == '.' || name.front() == '-') name.front() = '_';
+  name = name.substr(0, 80);
+  return name + "-" + stamp;
 }
 
 void checkMapName(const std::string& name) {

@@ -144,8 +144,15 @@ TEST(MapCommand, KilledRunLeavesAStoreThatOpens) {
   int pid = 0;
   ASSERT_EQ(std::fscanf(pipe, "%d", &pid), 1);
   ::pclose(pipe);
-  // Well into the run (30 fps: ~200 frames), while batches are being written.
-  std::this_thread::sleep_for(std::chrono::seconds(8));
+  // Well into the run (30 fps: ~200 frames), while batches are being written; readers look on.
+  std::this_thread::sleep_for(std::chrono::seconds(6));
+  const auto live = test::runEdgeslam("map list --json --maps " + store.string(), false);
+  EXPECT_EQ(live.exit_code, 0) << live.output;
+  EXPECT_EQ(jsonOf(live)["maps"][0]["name"], "killed") << live.output;
+  const auto locked = test::runEdgeslam("map rm killed --maps " + store.string());
+  EXPECT_EQ(locked.exit_code, 1) << locked.output;
+  EXPECT_NE(locked.output.find("locked"), std::string::npos) << locked.output;
+  std::this_thread::sleep_for(std::chrono::seconds(2));
   ASSERT_EQ(::kill(pid, SIGKILL), 0);
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   const auto info =
