@@ -91,15 +91,6 @@ SqliteMapStore::SqliteMapStore(const std::filesystem::path& file, MapStoreAccess
     throw StoreError(file.string() + ": the map store is read-only");
   }
   try {
-    if (writable) {
-      SqliteStatement journal(db_, "PRAGMA journal_mode = WAL");
-      if (!journal.step() || journal.columnText(0) != "wal") {
-        throw StoreError("cannot switch the map store to WAL mode");
-      }
-      // WAL with NORMAL: a killed process loses nothing committed; a power cut at most the last
-      // transactions, never the store.
-      db_.execute("PRAGMA synchronous = NORMAL");
-    }
     db_.execute("PRAGMA foreign_keys = ON");
     {
       SqliteStatement check(db_, "PRAGMA quick_check(1)");
@@ -109,7 +100,21 @@ SqliteMapStore::SqliteMapStore(const std::filesystem::path& file, MapStoreAccess
         throw StoreError("the map store is damaged (malformed: " + finding + ")");
       }
     }
-    prepareSchema(db_, writable);
+    // Before anything is written (WAL mode changes the header): a store that will be refused is
+    // left byte for byte as it was.
+    checkSchema(db_, writable);
+    if (writable) {
+      {
+        SqliteStatement journal(db_, "PRAGMA journal_mode = WAL");
+        if (!journal.step() || journal.columnText(0) != "wal") {
+          throw StoreError("cannot switch the map store to WAL mode");
+        }
+      }
+      // WAL with NORMAL: a killed process loses nothing committed; a power cut at most the last
+      // transactions, never the store.
+      db_.execute("PRAGMA synchronous = NORMAL");
+      prepareSchema(db_);
+    }
     statements_ = std::make_unique<Statements>(db_);
   } catch (const std::exception& e) {
     throw StoreError(withFile(db_, e));

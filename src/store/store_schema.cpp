@@ -72,24 +72,20 @@ CREATE TABLE masks(
 using Migration = void (*)(SqliteDatabase&);
 constexpr Migration kMigrations[] = {nullptr};
 
+int tableCount(SqliteDatabase& db) {
+  SqliteStatement count(db, "SELECT count(*) FROM sqlite_master");
+  return count.step() ? static_cast<int>(count.columnInt(0)) : 0;
+}
+
 }  // namespace
 
-void prepareSchema(SqliteDatabase& db, bool writable) {
+void checkSchema(SqliteDatabase& db, bool writable) {
   const std::string file = db.file().string();
   // The first read of a file that is not SQLite (or whose header is damaged) fails here.
   const int application_id = pragmaInt(db, "application_id");
   const int version = pragmaInt(db, "user_version");
-  const int tables = [&] {
-    SqliteStatement count(db, "SELECT count(*) FROM sqlite_master");
-    return count.step() ? static_cast<int>(count.columnInt(0)) : 0;
-  }();
-  if (tables == 0 && version == 0) {
+  if (tableCount(db) == 0 && version == 0) {
     if (!writable) throw StoreError(file + ": the map store is empty (no schema)");
-    SqliteTransaction transaction(db);
-    createTables(db);
-    db.execute("PRAGMA application_id = " + std::to_string(kStoreApplicationId));
-    db.execute("PRAGMA user_version = " + std::to_string(kSchemaVersion));
-    transaction.commit();
     return;
   }
   if (application_id != kStoreApplicationId) {
@@ -104,11 +100,23 @@ void prepareSchema(SqliteDatabase& db, bool writable) {
     throw StoreError(file + ": map store schema version " + std::to_string(version) +
                      " is unknown");
   }
+  if (version < kSchemaVersion && !writable) {
+    throw StoreError(file + ": map store schema version " + std::to_string(version) +
+                     " needs migrating: open it once with `edgeslam server --maps`");
+  }
+}
+
+void prepareSchema(SqliteDatabase& db) {
+  const int version = pragmaInt(db, "user_version");
+  if (tableCount(db) == 0 && version == 0) {
+    SqliteTransaction transaction(db);
+    createTables(db);
+    db.execute("PRAGMA application_id = " + std::to_string(kStoreApplicationId));
+    db.execute("PRAGMA user_version = " + std::to_string(kSchemaVersion));
+    transaction.commit();
+    return;
+  }
   if (version < kSchemaVersion) {
-    if (!writable) {
-      throw StoreError(file + ": map store schema version " + std::to_string(version) +
-                       " needs migrating: open it once with `edgeslam server --maps`");
-    }
     SqliteTransaction transaction(db);
     for (int v = version; v < kSchemaVersion; ++v) kMigrations[v - 1](db);
     db.execute("PRAGMA user_version = " + std::to_string(kSchemaVersion));

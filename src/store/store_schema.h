@@ -11,8 +11,9 @@ constexpr int kSchemaVersion = 1;
 // "ESLM": tells an edgeslam store from any other SQLite file.
 constexpr int kStoreApplicationId = 0x45534c4d;
 
-// Throws StoreError naming the file: not a store, damaged, or a newer version. `writable`: create
-// or migrate when needed (a reader only checks).
-void prepareSchema(SqliteDatabase& db, bool writable);
+// Throws StoreError naming the file: not a store, damaged, or a newer version; writes nothing.
+void checkSchema(SqliteDatabase& db, bool writable);
+// After checkSchema: creates the schema of a new store or migrates an older one.
+void prepareSchema(SqliteDatabase& db);
 
 }  // namespace edgeslam

