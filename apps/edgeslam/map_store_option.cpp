@@ -59,6 +59,7 @@ nlohmann::json storeMetrics(const MapStoreChoice& choice, const std::string& nam
                         {"batches", t.batches},
                         {"keyframes_written", t.keyframes_written},
                         {"points_written", t.points_written},
+                        {"points_moved", t.points_moved},
                         {"failures", t.failures},
                         {"write_ms", toJson(t.write_ms)},
                         {"copy_ms", toJson(t.copy_ms)}};

@@ -45,12 +45,15 @@ struct MapStoreBatch {
   std::vector<KeyFrameRecord> keyframes;  // new keyframes (whole records; point_ids unused)
   std::vector<KeyFramePoseRecord> poses;  // keyframes already stored whose pose changed
   std::vector<MapPointRecord> points;     // new or changed points, whole
+  // Stored points that only moved: position, normal and distance range (the rest is unchanged).
+  std::vector<MapPointRecord> points_moved;
   std::vector<MapPointId> points_erased;
   std::vector<KeyFrameId> keyframes_erased;
   std::vector<MaskRecord> masks;  // semantic labels of keyframes
   bool empty() const {
     return !cleared && keyframes.empty() && poses.empty() && points.empty() &&
-           points_erased.empty() && keyframes_erased.empty() && masks.empty();
+           points_moved.empty() && points_erased.empty() && keyframes_erased.empty() &&
+           masks.empty();
   }
 };
 

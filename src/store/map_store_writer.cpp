@@ -8,12 +8,13 @@
 
 namespace edgeslam {
 
-void MapStoreWriteStats::addBatch(std::size_t keyframes, std::size_t points, double copy_ms,
-                                  double write_ms) {
+void MapStoreWriteStats::addBatch(std::size_t keyframes, std::size_t points,
+                                  std::size_t points_moved, double copy_ms, double write_ms) {
   std::lock_guard lock(mutex_);
   ++totals_.batches;
   totals_.keyframes_written += keyframes;
   totals_.points_written += points;
+  totals_.points_moved += points_moved;
   write_ms_.add(write_ms);
   copy_ms_.add(copy_ms);
 }
@@ -67,6 +68,7 @@ void MapStoreWriter::onMapCleared() {
   cleared_ = true;
   keyframes_.clear();
   points_.clear();
+  points_moved_.clear();
   masks_.clear();
 }
 
@@ -76,9 +78,16 @@ void MapStoreWriter::onMapChanged(const MapChanges& changes) {
        {&changes.keyframes_created, &changes.keyframes_updated, &changes.keyframes_erased}) {
     keyframes_.insert(ids->begin(), ids->end());
   }
-  for (const auto* ids : {&changes.points_created, &changes.points_updated, &changes.points_moved,
-                          &changes.points_erased}) {
-    points_.insert(ids->begin(), ids->end());
+  for (const auto* ids :
+       {&changes.points_created, &changes.points_updated, &changes.points_erased}) {
+    for (const MapPointId id : *ids) {
+      points_.insert(id);
+      points_moved_.erase(id);
+    }
+  }
+  // Bundle adjustment moves many points at a time: those are updated in place, not rewritten.
+  for (const MapPointId id : changes.points_moved) {
+    if (!points_.contains(id)) points_moved_.insert(id);
   }
 }
 
@@ -91,12 +100,14 @@ MapStoreBatch MapStoreWriter::takeBatch() {
   MapStoreBatch batch;
   std::unordered_set<KeyFrameId> keyframes;
   std::unordered_set<MapPointId> points;
+  std::unordered_set<MapPointId> points_moved;
   {
     std::lock_guard lock(pending_mutex_);
     batch.cleared = cleared_;
     cleared_ = false;
     keyframes.swap(keyframes_);
     points.swap(points_);
+    points_moved.swap(points_moved_);
     batch.masks.swap(masks_);
   }
   if (batch.cleared) stored_keyframes_.clear();
@@ -120,6 +131,19 @@ MapStoreBatch MapStoreWriter::takeBatch() {
       batch.points.push_back(mapPointRecord(*point));
     }
   }
+  for (const MapPointId id : points_moved) {
+    const MapPoint* point = map_.mapPoint(id);
+    if (point == nullptr || point->isBad()) {
+      batch.points_erased.push_back(id);
+      continue;
+    }
+    MapPointRecord& moved = batch.points_moved.emplace_back();
+    moved.id = id;
+    moved.position = point->position();
+    moved.normal = point->normal();
+    moved.min_distance = point->baseMinDistance();
+    moved.max_distance = point->baseMaxDistance();
+  }
   return batch;
 }
 
@@ -134,8 +158,8 @@ void MapStoreWriter::flush() {
   try {
     store_->write(session_, batch);
     if (stats_) {
-      stats_->addBatch(batch.keyframes.size(), batch.points.size(), copy_ms,
-                       write_timer.elapsedMs());
+      stats_->addBatch(batch.keyframes.size(), batch.points.size(), batch.points_moved.size(),
+                       copy_ms, write_timer.elapsedMs());
     }
   } catch (const std::exception& e) {
     // The batch is lost (the transaction rolled back); later batches carry on so that at least

@@ -23,7 +23,8 @@ class MapStoreWriter;
 // have every live one write what it has now (before a run reports its figures).
 class MapStoreWriteStats {
  public:
-  void addBatch(std::size_t keyframes, std::size_t points, double copy_ms, double write_ms);
+  void addBatch(std::size_t keyframes, std::size_t points, std::size_t points_moved, double copy_ms,
+                double write_ms);
   void addFailure();
   void attach(MapStoreWriter* writer);
   void detach(MapStoreWriter* writer);
@@ -31,7 +32,8 @@ class MapStoreWriteStats {
   struct Totals {
     std::uint64_t batches = 0;
     std::uint64_t keyframes_written = 0;
-    std::uint64_t points_written = 0;
+    std::uint64_t points_written = 0;  // whole
+    std::uint64_t points_moved = 0;    // position updates only
     std::uint64_t failures = 0;
     PercentileSummary write_ms;  // per batch, the store's transaction
     PercentileSummary copy_ms;   // per batch, the copy under the map's mutex
@@ -78,8 +80,9 @@ class MapStoreWriter : public MapChangeObserver {
   std::condition_variable wake_;
   bool stopping_ = false;
   bool cleared_ = false;
-  std::unordered_set<KeyFrameId> keyframes_;  // created, changed or erased since the last batch
-  std::unordered_set<MapPointId> points_;
+  std::unordered_set<KeyFrameId> keyframes_;     // created, changed or erased since the last batch
+  std::unordered_set<MapPointId> points_;        // written whole
+  std::unordered_set<MapPointId> points_moved_;  // only moved (and not in points_)
   std::vector<MaskRecord> masks_;
 
   std::mutex write_mutex_;                           // one batch at a time

@@ -71,6 +71,9 @@ struct SqliteMapStore::Statements {
                      "INSERT OR REPLACE INTO points(session_id, id, x, y, z, nx, ny, nz, "
                      "descriptor, min_distance, max_distance, reference, observations) "
                      "VALUES(?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?, ?)"),
+        move_point(db,
+                   "UPDATE points SET x = ?, y = ?, z = ?, nx = ?, ny = ?, nz = ?, min_distance = "
+                   "?, max_distance = ? WHERE session_id = ? AND id = ?"),
         erase_point(db, "DELETE FROM points WHERE session_id = ? AND id = ?"),
         insert_mask(db,
                     "INSERT OR REPLACE INTO masks(session_id, keyframe, width, height, encoding, "
@@ -79,7 +82,7 @@ struct SqliteMapStore::Statements {
   SqliteStatement map_id, insert_map, touch_map, insert_session, end_session;
   SqliteStatement clear_keyframes, clear_points, clear_masks;
   SqliteStatement insert_keyframe, update_pose, erase_keyframe, erase_mask;
-  SqliteStatement insert_point, erase_point, insert_mask;
+  SqliteStatement insert_point, move_point, erase_point, insert_mask;
 };
 
 SqliteMapStore::SqliteMapStore(const std::filesystem::path& file, MapStoreAccess access,
@@ -386,6 +389,13 @@ void SqliteMapStore::write(StoreSessionId session, const MapStoreBatch& batch) {
     q.bind(11, static_cast<double>(p.max_distance)).bind(12, toSql(p.reference_keyframe));
     q.bindBlob(13, observationsBlob(p.observations));
     q.run();
+  }
+  for (const MapPointRecord& p : batch.points_moved) {
+    SqliteStatement& q = s.move_point;
+    q.bind(1, p.position.x()).bind(2, p.position.y()).bind(3, p.position.z());
+    q.bind(4, p.normal.x()).bind(5, p.normal.y()).bind(6, p.normal.z());
+    q.bind(7, static_cast<double>(p.min_distance)).bind(8, static_cast<double>(p.max_distance));
+    q.bind(9, session).bind(10, toSql(p.id)).run();
   }
   for (const MapPointId id : batch.points_erased) {
     s.erase_point.bind(1, session).bind(2, toSql(id)).run();

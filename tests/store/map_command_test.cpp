@@ -172,6 +172,58 @@ TEST(MapCommand, KilledRunLeavesAStoreThatOpens) {
   std::filesystem::remove_all(store);
 }
 
+int startInBackground(const std::string& arguments) {
+  const std::string command =
+      test::edgeslamBinary().string() + " " + arguments + " > /dev/null 2>&1 & echo $!";
+  FILE* pipe = ::popen(command.c_str(), "r");
+  int pid = 0;
+  if (pipe == nullptr || std::fscanf(pipe, "%d", &pid) != 1) pid = 0;
+  if (pipe != nullptr) ::pclose(pipe);
+  return pid;
+}
+
+// Two processes: the server's store is written while the client maps, and a server killed with
+// SIGKILL leaves it openable, holding what was mapped, for the next server.
+TEST(MapCommand, KilledServerLeavesItsMapsForTheNextOne) {
+  EDGESLAM_REQUIRE_SHARED(kSequence);
+  const auto store = tempDir("server");
+  const int port = 48000 + static_cast<int>(::getpid() % 1000);
+  const std::string serve = "server --listen 127.0.0.1:" + std::to_string(port) +
+                            " --status-every 0 --vocab none --semantic off --maps " +
+                            store.string();
+  const int server = startInBackground(serve);
+  ASSERT_GT(server, 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(800));
+  const int client = startInBackground("client --server 127.0.0.1:" + std::to_string(port) +
+                                       " --dataset " + test::sharedPath(kSequence).string() +
+                                       " --sensor rgbd --realtime --vocab none --map office");
+  ASSERT_GT(client, 0);
+  std::this_thread::sleep_for(std::chrono::seconds(8));
+  ASSERT_EQ(::kill(server, SIGKILL), 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  ::kill(client, SIGKILL);
+  const auto info =
+      test::runEdgeslam("map info office --json --load --maps " + store.string(), false);
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  const auto m = jsonOf(info);
+  EXPECT_GE(m["keyframes"].get<int>(), 3) << info.output;
+  EXPECT_EQ(m["load"]["keyframes"], m["keyframes"]);
+  // The next server opens the store (the lock went with the killed one) and serves on.
+  const int next = startInBackground(serve);
+  ASSERT_GT(next, 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(800));
+  const auto second = test::runEdgeslam("client --server 127.0.0.1:" + std::to_string(port) +
+                                        " --dataset " + test::sharedPath(kSequence).string() +
+                                        " --sensor rgbd --max-frames 30 --vocab none --map office");
+  ::kill(next, SIGTERM);
+  EXPECT_EQ(second.exit_code, 0) << second.output;
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  const auto after =
+      jsonOf(test::runEdgeslam("map info office --json --maps " + store.string(), false));
+  EXPECT_EQ(after["sessions"], 2) << after.dump();
+  std::filesystem::remove_all(store);
+}
+
 TEST(MapCommand, DamagedStoreIsOneLineNamingTheFile) {
   const auto store = tempDir("damaged");
   std::filesystem::create_directories(store);

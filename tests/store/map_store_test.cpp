@@ -111,11 +111,20 @@ TEST(MapStore, LaterBatchesUpdatePosesAndEraseWhatTheMapErased) {
   const MapPointId doomed_id = doomed->id();
   small.map.setKeyFramePose(moved, corrected);
   small.map.erasePoint(doomed);
+  MapPoint* shifted = small.keyframes[1]->goodPoints().back();
+  const Eigen::Vector3d shifted_to = shifted->position() + Eigen::Vector3d(0.5, 0, 0);
+  small.map.relocatePoint(shifted, shifted_to);
   take();
   writer.flush();
   const StoredSession loaded = onlySession(*store->loadMap("m"));
   EXPECT_EQ(loaded.points.size(), small.map.pointCount());
-  for (const MapPointRecord& p : loaded.points) EXPECT_NE(p.id, doomed_id);
+  for (const MapPointRecord& p : loaded.points) {
+    EXPECT_NE(p.id, doomed_id);
+    if (p.id == shifted->id()) {
+      EXPECT_EQ(p.position, shifted_to);                                 // moved in place...
+      EXPECT_EQ(p.observations.size(), shifted->observations().size());  // ...the rest kept
+    }
+  }
   EXPECT_EQ(loaded.keyframes[2].T_cw.translation(), Eigen::Vector3d(1, 2, 3));
 
   // A failed start empties the session's map.
