@@ -8,7 +8,7 @@ packages=(
   libgrpc++-dev libprotobuf-dev protobuf-compiler protobuf-compiler-grpc
   libgtest-dev libgmock-dev libbenchmark-dev
   libspdlog-dev libfmt-dev libcli11-dev nlohmann-json3-dev libyaml-cpp-dev libzstd-dev
-  libcpp-httplib-dev
+  libcpp-httplib-dev libsqlite3-dev
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -19,6 +19,7 @@
 #include "io/frame_prefetcher.h"
 #include "io/trajectory.h"
 #include "link/link_settings.h"
+#include "map_store_option.h"
 #include "pipeline/edge_slam.h"
 #include "pipeline/embedded_edge.h"
 #include "pipeline/grpc_edge_link.h"
@@ -31,6 +32,7 @@
 #include "run_viewer.h"
 #include "segmenter_option.h"
 #include "semantic_evaluation.h"
+#include "store/store_location.h"
 #include "util/timing_stats.h"
 #include "vocabulary_option.h"
 
@@ -85,6 +87,7 @@ Sensor toSensor(const std::string& name) {
 // The edge the client talks to: a remote server (`client --server`), or one embedded in this
 // process on loopback, behind the link emulator when a profile is asked for.
 struct EdgeEndpoint {
+  MapStoreChoice store;  // the embedded edge's; declared first, so the edge goes before it
   std::unique_ptr<EmbeddedEdge> embedded;
   std::string address;
 };
@@ -95,6 +98,10 @@ EdgeEndpoint openEdge(const RunOptions& options, std::shared_ptr<const Vocabular
     edge.address = options.server_address;
     if (options.link != "none") {
       spdlog::warn("--link applies to the embedded edge only; talking to {} directly",
+                   edge.address);
+    }
+    if (!options.maps.empty()) {
+      spdlog::warn("--maps applies to the embedded edge only; {} keeps maps in its own store",
                    edge.address);
     }
     return edge;
@@ -110,6 +117,10 @@ EdgeEndpoint openEdge(const RunOptions& options, std::shared_ptr<const Vocabular
     session.mapping.mapper.triangulation_search =
         *parseTriangulationSearch(*options.triangulation_search);
   }
+  // Offload sessions keep no map yet: only edge mode opens the store.
+  if (options.mode == "edge") edge.store = openStoreForWriting(options.maps);
+  session.store = edge.store.store;
+  session.store_stats = edge.store.stats;
   edge.embedded = std::make_unique<EmbeddedEdge>(session, link);
   edge.address = edge.embedded->clientAddress();
   spdlog::info("edge server on loopback, client connects to {}{}", edge.address,
@@ -121,6 +132,7 @@ SessionConfig sessionConfig(const PinholeCamera& camera, Sensor sensor,
                             const SlamOptions& slam_options, const RunOptions& options) {
   SessionConfig config;
   config.client_name = "edgeslam-client";
+  config.map_name = options.map_name;
   config.camera = camera;
   config.sensor = sensor;
   config.settings.features = slam_options.orb.num_features;
@@ -157,7 +169,8 @@ std::unique_ptr<SlamSystem> makeSlamSystem(const RunOptions& options, const std:
   return std::make_unique<EdgeSlam>(camera, slam_options, std::move(link), adaptation);
 }
 
-int runPipeline(const RunOptions& options) {
+int runPipeline(const RunOptions& given) {
+  RunOptions options = given;  // the map name may be chosen below
   // First, so that a port that cannot be served ends the run before anything is loaded.
   std::unique_ptr<RunViewer> viewer;
   if (options.viewer_port)
@@ -239,6 +252,13 @@ int runPipeline(const RunOptions& options) {
   spdlog::info("{} ORB features, {} levels; keyframes fmin {} fmax {} alpha {} beta {}",
                slam_options.orb.num_features, slam_options.orb.num_levels, kf.fmin, kf.fmax,
                kf.alpha, kf.beta);
+  if (mode == "local" && !options.maps.empty() && options.maps != "none") {
+    spdlog::warn("--maps: local runs keep no map yet (edge mode does)");
+  }
+  if (options.map_name.empty() && options.server_address.empty() && mode == "edge") {
+    options.map_name = defaultMapName(
+        info.path.filename().string().empty() ? std::string("run") : info.path.filename().string());
+  }
   const EdgeEndpoint edge =
       mode == "local" ? EdgeEndpoint{} : openEdge(options, slam_options.vocabulary);
   const std::unique_ptr<SlamSystem> slam_system =
@@ -334,6 +354,8 @@ int runPipeline(const RunOptions& options) {
   }
   progress.finish();
   slam.finish();
+  // What the edge's map store holds now (the last changes written first).
+  const nlohmann::json store_metrics = storeMetrics(edge.store, options.map_name);
   const double seconds = wall.elapsedMs() / 1000.0;
   const PercentileSummary client = client_ms.summary();
 
@@ -457,6 +479,7 @@ int runPipeline(const RunOptions& options) {
   }
   if (ate) metrics["ate"] = *ate;
   if (ate_final) metrics["ate_final"] = *ate_final;
+  if (!store_metrics.is_null()) metrics["store"] = store_metrics;
   if (viewer) metrics["viewer_port"] = viewer->port();
   const std::optional<MapIntrinsicsRefinement> refinement = slam.intrinsicsRefinement();
   if (refinement) metrics["intrinsics_refinement"] = intrinsicsRefinementJson(*refinement);
@@ -508,6 +531,16 @@ int runPipeline(const RunOptions& options) {
                (*ate_final)["rmse_m"].get<double>(), (*ate_final)["pairs"].get<std::size_t>());
   }
   if (refinement) fmt::print("  intrinsics   {}\n", describe(*refinement));
+  if (!store_metrics.is_null() && store_metrics.contains("bytes")) {
+    fmt::print(
+        "  map store    '{}' in {}: {} keyframes, {} points, {} B ({} B per keyframe), "
+        "write median {:.1f} ms per batch\n",
+        options.map_name, store_metrics["location"].get<std::string>(),
+        store_metrics["keyframes"].get<std::uint64_t>(),
+        store_metrics["points"].get<std::uint64_t>(), store_metrics["bytes"].get<std::uint64_t>(),
+        store_metrics["bytes_per_keyframe"].get<std::uint64_t>(),
+        store_metrics["write_ms"]["median"].get<double>());
+  }
   if (counters.backend.waits > 0 || frames_dropped_late > 0) {
     fmt::print(
         "  pacing       {}: waited for the back end {} times, {:.1f} s in all; {} frames "
@@ -585,6 +618,18 @@ void addRunOptions(CLI::App* run, const std::shared_ptr<RunOptions>& options) {
       ->check(CLI::Range(0, 300))
       ->capture_default_str();
   run->add_option("--max-frames", options->max_frames, "Process at most N frames (0 = all)");
+  addMapsOption(run, options->maps);
+  run->add_option("--map", options->map_name,
+                  "Edge map this session writes into (created when new; default: a new map named "
+                  "after the dataset and time)")
+      ->check([](const std::string& name) {
+        try {
+          checkMapName(name);
+          return std::string();
+        } catch (const std::invalid_argument& e) {
+          return std::string(e.what());
+        }
+      });
   auto* realtime = run->add_flag("--realtime", options->realtime,
                                  "Feed frames at the dataset's rate, dropping none");
   run->add_flag("--fast", options->fast, "Feed frames as fast as possible (the default)")

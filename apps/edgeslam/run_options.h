@@ -16,6 +16,8 @@ struct RunOptions {
   std::string mode = "edge";    // edge|local|offload
   std::string link = "none";
   std::string server_address;  // `client`: the edge server; empty = embedded on loopback
+  std::string maps;            // the embedded edge's map store: "" = default, "none" = none
+  std::string map_name;        // the edge map this session writes into; "" = a new one
   bool adapt = true;
   bool semantic = false;
   std::filesystem::path models_dir;  // segmentation models; "" = the shared models folder

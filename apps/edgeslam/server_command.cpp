@@ -9,6 +9,7 @@
 #include <thread>
 
 #include "commands.h"
+#include "map_store_option.h"
 #include "pipeline/slam_session_backend.h"
 #include "segmenter_option.h"
 #include "vocabulary_option.h"
@@ -29,6 +30,7 @@ struct ServerOptions {
   std::string semantic = "auto";
   std::filesystem::path models_dir;
   int segment_input = 256;
+  std::string maps;
 };
 
 int runServer(const ServerOptions& o) {
@@ -45,6 +47,15 @@ int runServer(const ServerOptions& o) {
       if (o.semantic == "on") throw;
       spdlog::warn("no segmentation ({}): sessions asking for semantic culling are refused",
                    e.what());
+    }
+  }
+  const MapStoreChoice store = openStoreForWriting(o.maps);
+  options.store = store.store;
+  options.store_stats = store.stats;
+  if (store.store) {
+    for (const MapSummary& map : store.store->listMaps()) {
+      spdlog::info("map '{}': {} keyframes, {} points, {} session(s)", map.name, map.keyframes,
+                   map.points, map.sessions);
     }
   }
   const std::string& listen = o.listen;
@@ -88,6 +99,7 @@ void addServerCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--models", o->models_dir,
                   "Segmentation models folder (default: the shared models)");
+  addMapsOption(cmd, o->maps);
   cmd->callback([o] { exitCode() = runServer(*o); });
 }
 

@@ -86,6 +86,7 @@ void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
       mapper_->onMapReset();
       if (loop_closer_) loop_closer_->onMapReset();
       map_.clear();
+      if (observer_ != nullptr) observer_->onMapCleared();
       window_.clear();
       window_centre_ = kInvalidId;
     }
@@ -126,6 +127,15 @@ void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
     map_.setChangeRecording(true);
     // Where the edge's map differs from what the client sent, the slices say so.
     resolveUploadedPointConflicts(map_, conflicts);
+    if (observer_ != nullptr) {
+      // Applied without recording (the client has it): the observer still needs all of it.
+      MapChanges uploaded;
+      uploaded.keyFrameCreated(keyframe->id());
+      for (const MapPoint* point : keyframe->points()) {
+        if (point != nullptr) uploaded.pointUpdated(point->id());
+      }
+      observer_->onMapChanged(uploaded);
+    }
     window_.clientHolds(keyframe->id());
     std::lock_guard state(state_mutex_);
     ++stats_.uploads;
@@ -163,7 +173,12 @@ void EdgeMapSession::publishSlice(KeyFrame* mapped) {
     if (mapped == nullptr && map_.changes().empty() && loops == loops_published_ && masks.empty()) {
       return;
     }
-    slice = buildSlice(map_, map_.takeChanges());
+    MapChanges changes = map_.takeChanges();
+    if (observer_ != nullptr) {
+      observer_->onMapChanged(changes);
+      if (!masks.empty()) observer_->onMasks(masks);
+    }
+    slice = buildSlice(map_, changes);
     if (mapped != nullptr && !mapped->isBad()) window_centre_ = mapped->id();
     // Loop corrections and global BA keep the window of the last mapped keyframe.
     const std::size_t entering_before = slice.keyframes.size();

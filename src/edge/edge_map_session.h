@@ -15,6 +15,7 @@
 #include "edge/loop_closer.h"
 #include "geometry/camera.h"
 #include "map/map.h"
+#include "map/map_change_observer.h"
 #include "map/map_records.h"
 #include "map/sensor.h"
 
@@ -84,6 +85,9 @@ class EdgeMapSession {
   const KeyFrameSegmentationWorker* segmentation() const { return segmentation_.get(); }
   // Box NMS threshold of the segmenter (paper Table I's nm), from the next keyframe on.
   void setNmsThreshold(float nm);
+  // Told every change of the global map (uploads applied too) and every mask; set before the
+  // first keyframe. Not owned: it outlives the session's threads (stop() first).
+  void setChangeObserver(MapChangeObserver* observer) { observer_ = observer; }
 
  private:
   // `mapped`: the keyframe just mapped, or nullptr for a loop correction or global BA.
@@ -92,6 +96,7 @@ class EdgeMapSession {
 
   PinholeCamera camera_;
   Map map_;
+  MapChangeObserver* observer_ = nullptr;
   std::unique_ptr<LocalMapper> mapper_;
   std::unique_ptr<LoopCloser> loop_closer_;
   std::unique_ptr<KeyFrameSegmentationWorker> segmentation_;

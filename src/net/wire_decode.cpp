@@ -562,6 +562,8 @@ SessionConfig fromProto(const v1::OpenSessionRequest& in) {
     SessionConfig out;
     if (in.client_name().size() > 256) throw WireError("client name longer than 256 characters");
     out.client_name = in.client_name();
+    if (in.map_name().size() > 256) throw WireError("map name longer than 256 characters");
+    out.map_name = in.map_name();
     const v1::Camera& c = in.camera();
     const auto max_side = static_cast<std::uint32_t>(wire_limits::kMaxImageSide);
     if (c.width() > max_side || c.height() > max_side) {

@@ -434,6 +434,7 @@ void toProto(const MapSlice& slice, v1::MapSlice* out, const WireEncodeOptions& 
 
 void toProto(const SessionConfig& config, v1::OpenSessionRequest* out) {
   out->set_client_name(config.client_name);
+  out->set_map_name(config.map_name);
   const CameraIntrinsics& in = config.camera.intrinsics();
   v1::Camera* camera = out->mutable_camera();
   camera->set_width(static_cast<std::uint32_t>(std::max(in.width, 0)));

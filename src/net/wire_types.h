@@ -27,6 +27,7 @@ struct SessionSettings {
 // What a client opens a session with; id_origin and session_id are filled in by the server.
 struct SessionConfig {
   std::string client_name;
+  std::string map_name;  // the edge map to write into; "" = a new one
   PinholeCamera camera;
   Sensor sensor = Sensor::kMonocular;
   SessionSettings settings;

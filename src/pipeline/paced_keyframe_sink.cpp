@@ -11,7 +11,7 @@ void PacedKeyFrameSink::insertKeyFrame(KeyFrame* keyframe) {
     wait_until_idle_();
     const double ms = waited.elapsedMs();
     if (ms >= kWaitedMs) {
-      std::lock_guard lock(mutex_);
+      MutexLock lock(mutex_);
       waits_ms_.add(ms);
       wait_total_ms_ += ms;
     }
@@ -26,7 +26,7 @@ bool PacedKeyFrameSink::acceptsKeyFrames() const {
 }
 
 BackendPacing PacedKeyFrameSink::pacing() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   return {waits_ms_.count(), wait_total_ms_, waits_ms_.summary(), busy_refusals_.load()};
 }
 

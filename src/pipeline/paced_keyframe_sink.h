@@ -12,10 +12,10 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
-#include <mutex>
 
 #include "map/keyframe_sink.h"
 #include "util/timing_stats.h"
+#include "util/mutex.h"
 
 namespace edgeslam {
 
@@ -46,9 +46,9 @@ class PacedKeyFrameSink : public KeyFrameSink {
 
   KeyFrameSink& inner_;
   std::function<void()> wait_until_idle_;
-  mutable std::mutex mutex_;
-  SampleStats waits_ms_;
-  double wait_total_ms_ = 0.0;
+  mutable Mutex mutex_;
+  SampleStats waits_ms_ GUARDED_BY(mutex_);
+  double wait_total_ms_ GUARDED_BY(mutex_) = 0.0;
   mutable std::atomic<std::uint64_t> busy_refusals_{0};
 };
 

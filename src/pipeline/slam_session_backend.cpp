@@ -8,6 +8,7 @@
 
 #include "net/wire_error.h"
 #include "pipeline/local_slam.h"
+#include "store/store_location.h"
 #include "util/timing_stats.h"
 
 namespace edgeslam {
@@ -48,6 +49,7 @@ SlamSessionBackend::SlamSessionBackend(const SessionConfig& config, SliceSink& s
 
 SlamSessionBackend::~SlamSessionBackend() {
   if (mapping_) mapping_->stop();
+  if (store_writer_) store_writer_->stop();
 }
 
 void SlamSessionBackend::onKeyFrame(KeyFrameUpload upload) {
@@ -66,8 +68,29 @@ void SlamSessionBackend::onKeyFrame(KeyFrameUpload upload) {
             spdlog::error("session {}: slice not sent: {}", config_.session_id, e.what());
           }
         });
+    startStoreWriter();
   }
   mapping_->onKeyFrame(upload);
+}
+
+void SlamSessionBackend::startStoreWriter() {
+  if (!options_.store) return;
+  const std::string map =
+      !config_.map_name.empty()
+          ? config_.map_name
+          : defaultMapName(config_.client_name + "-s" + std::to_string(config_.session_id));
+  try {
+    const StoreSessionId session =
+        options_.store->beginSession(map, {config_.client_name, config_.camera, config_.sensor});
+    store_writer_ = std::make_unique<MapStoreWriter>(options_.store, session, mapping_->map(),
+                                                     options_.store_stats);
+    mapping_->setChangeObserver(store_writer_.get());
+    spdlog::info("session {}: writing map '{}' to {}", config_.session_id, map,
+                 options_.store->location());
+  } catch (const std::exception& e) {
+    // The session still maps; only its persistence is lost, and said so.
+    spdlog::error("session {}: map '{}' not stored: {}", config_.session_id, map, e.what());
+  }
 }
 
 std::optional<OffloadResult> SlamSessionBackend::onFrame(OffloadFrame frame) {
@@ -111,6 +134,7 @@ std::unique_ptr<EdgeSessionBackend> SlamSessionFactory::open(const SessionConfig
         "the client asks for semantic culling and this edge server has no segmenter (start it "
         "with --semantic on and the models)");
   }
+  if (!config.map_name.empty()) checkMapName(config.map_name);
   spdlog::info("edge: session {} for '{}' ({}x{}, {})", config.session_id, config.client_name,
                config.camera.width(), config.camera.height(), toString(config.sensor));
   return std::make_unique<SlamSessionBackend>(config, sink, options_);

@@ -8,6 +8,7 @@
 #include "edge/edge_map_session.h"
 #include "net/edge_server.h"
 #include "pipeline/slam_system.h"
+#include "store/map_store_writer.h"
 
 namespace edgeslam {
 
@@ -16,6 +17,10 @@ struct SlamSessionOptions {
   // Sessions that ask for semantic culling get a segmenter made with these; without, such a
   // session is refused.
   std::optional<SegmenterOptions> segmenter;
+  // Edge sessions write their map here as it changes (nullptr = kept in memory only), into the
+  // map the client names or a new one; what the writers did is added to store_stats.
+  std::shared_ptr<MapStore> store;
+  std::shared_ptr<MapStoreWriteStats> store_stats;
 };
 
 class SlamSessionBackend : public EdgeSessionBackend {
@@ -27,12 +32,15 @@ class SlamSessionBackend : public EdgeSessionBackend {
   std::optional<OffloadResult> onFrame(OffloadFrame frame) override;
 
  private:
+  void startStoreWriter();
+
   SessionConfig config_;
   SliceSink& sink_;
   SlamSessionOptions options_;
-  std::shared_ptr<Segmenter> segmenter_;     // when the session asked for semantic culling
-  std::unique_ptr<EdgeMapSession> mapping_;  // edge mode, made at the first keyframe
-  std::unique_ptr<SlamSystem> offload_;      // offload mode, made at the first frame
+  std::shared_ptr<Segmenter> segmenter_;          // when the session asked for semantic culling
+  std::unique_ptr<MapStoreWriter> store_writer_;  // outlives mapping_, which it observes
+  std::unique_ptr<EdgeMapSession> mapping_;       // edge mode, made at the first keyframe
+  std::unique_ptr<SlamSystem> offload_;           // offload mode, made at the first frame
 };
 
 class SlamSessionFactory : public EdgeSessionFactory {

@@ -1,0 +1,104 @@
+#pragma once
+// Where edge maps persist: named maps, each made of the sessions that wrote into it. A session's
+// keyframes and points keep the ids they had in its map (ids are unique within a session only);
+// each session's map is in its own frame until maps are merged.
+//
+// The interface is what a server-class backend (PostgreSQL, for several edge nodes) implements
+// next to the embedded SQLite one (sqlite_map_store.h).
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "geometry/camera.h"
+#include "map/map_records.h"
+#include "map/sensor.h"
+
+namespace edgeslam {
+
+struct MapSummary {
+  std::string name;
+  std::uint64_t keyframes = 0;
+  std::uint64_t points = 0;
+  std::uint64_t sessions = 0;
+  std::uint64_t bytes = 0;  // payload bytes of the map's rows (blobs and values), roughly its share
+  double created = 0.0;     // Unix seconds
+  double updated = 0.0;
+  // Axis-aligned bounds of the points (zero when the map has none).
+  Eigen::Vector3d extent_min = Eigen::Vector3d::Zero();
+  Eigen::Vector3d extent_max = Eigen::Vector3d::Zero();
+};
+
+struct StoredSessionInfo {
+  std::string client;
+  PinholeCamera camera;
+  Sensor sensor = Sensor::kMonocular;
+};
+
+using StoreSessionId = std::int64_t;
+
+// One transaction's worth of changes of one session's map.
+struct MapStoreBatch {
+  bool cleared = false;  // the session's map was emptied (a failed start) before what follows
+  std::vector<KeyFrameRecord> keyframes;  // new keyframes (whole records; point_ids unused)
+  std::vector<KeyFramePoseRecord> poses;  // keyframes already stored whose pose changed
+  std::vector<MapPointRecord> points;     // new or changed points, whole
+  // Stored points that only moved: position, normal and distance range (the rest is unchanged).
+  std::vector<MapPointRecord> points_moved;
+  std::vector<MapPointId> points_erased;
+  std::vector<KeyFrameId> keyframes_erased;
+  std::vector<MaskRecord> masks;  // semantic labels of keyframes
+  bool empty() const {
+    return !cleared && keyframes.empty() && poses.empty() && points.empty() &&
+           points_moved.empty() && points_erased.empty() && keyframes_erased.empty() &&
+           masks.empty();
+  }
+};
+
+struct StoredSession {
+  StoreSessionId id = 0;
+  StoredSessionInfo info;
+  double started = 0.0;
+  double ended = 0.0;                     // 0 while open (or when the server died)
+  std::vector<KeyFrameRecord> keyframes;  // by id; point_ids filled from the observations
+  std::vector<MapPointRecord> points;     // by id
+  std::vector<MaskRecord> masks;
+};
+
+struct StoredMap {
+  std::string name;
+  std::vector<StoredSession> sessions;
+};
+
+class MapStore {
+ public:
+  virtual ~MapStore() = default;
+
+  // Where it is, for messages ("PATH/maps.sqlite").
+  virtual std::string location() const = 0;
+  virtual std::vector<MapSummary> listMaps() = 0;
+  virtual std::optional<MapSummary> mapInfo(const std::string& name) = 0;
+  virtual std::optional<StoredMap> loadMap(const std::string& name) = 0;
+  // Creates the map when it does not exist yet. Throws StoreError.
+  virtual StoreSessionId beginSession(const std::string& map, const StoredSessionInfo& info) = 0;
+  // In one transaction; throws StoreError, leaving the store as it was.
+  virtual void write(StoreSessionId session, const MapStoreBatch& batch) = 0;
+  virtual void endSession(StoreSessionId session) = 0;
+  virtual bool removeMap(const std::string& name) = 0;
+};
+
+enum class MapStoreAccess {
+  kRead,   // list, info, export: an existing store, read-only, beside a server writing to it
+  kEdit,   // rm: an existing store, locked (no server may be writing to it)
+  kServe,  // server, run: created when absent, locked while this process lives
+};
+
+// The embedded default: `directory`/maps.sqlite (and maps.lock, held by the one process that may
+// write). Throws StoreError with a one-line message naming the file: missing, corrupt, truncated,
+// newer schema, locked by another process, read-only.
+std::unique_ptr<MapStore> openMapStore(const std::filesystem::path& directory,
+                                       MapStoreAccess access);
+
+}  // namespace edgeslam

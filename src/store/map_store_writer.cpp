@@ -1,0 +1,203 @@
+#include "store/map_store_writer.h"
+
+#include <spdlog/spdlog.h>
+
+#include <chrono>
+
+#include "map/map_replication.h"
+
+namespace edgeslam {
+
+void MapStoreWriteStats::addBatch(std::size_t keyframes, std::size_t points,
+                                  std::size_t points_moved, double copy_ms, double write_ms) {
+  std::lock_guard lock(mutex_);
+  ++totals_.batches;
+  totals_.keyframes_written += keyframes;
+  totals_.points_written += points;
+  totals_.points_moved += points_moved;
+  write_ms_.add(write_ms);
+  copy_ms_.add(copy_ms);
+}
+
+void MapStoreWriteStats::addFailure() {
+  std::lock_guard lock(mutex_);
+  ++totals_.failures;
+}
+
+void MapStoreWriteStats::attach(MapStoreWriter* writer) {
+  std::lock_guard lock(writers_mutex_);
+  writers_.push_back(writer);
+}
+
+void MapStoreWriteStats::detach(MapStoreWriter* writer) {
+  std::lock_guard lock(writers_mutex_);
+  std::erase(writers_, writer);
+}
+
+void MapStoreWriteStats::flushAll() {
+  std::lock_guard lock(writers_mutex_);
+  for (MapStoreWriter* writer : writers_) writer->flush();
+}
+
+MapStoreWriteStats::Totals MapStoreWriteStats::totals() const {
+  std::lock_guard lock(mutex_);
+  Totals out = totals_;
+  out.write_ms = write_ms_.summary();
+  out.copy_ms = copy_ms_.summary();
+  return out;
+}
+
+MapStoreWriter::MapStoreWriter(std::shared_ptr<MapStore> store, StoreSessionId session,
+                               const Map& map, std::shared_ptr<MapStoreWriteStats> stats,
+                               double interval_s)
+    : store_(std::move(store)),
+      session_(session),
+      map_(map),
+      stats_(std::move(stats)),
+      interval_s_(interval_s) {
+  if (stats_) stats_->attach(this);
+  thread_ = std::thread([this] { run(); });
+}
+
+MapStoreWriter::~MapStoreWriter() {
+  stop();
+}
+
+void MapStoreWriter::onMapCleared() {
+  std::lock_guard lock(pending_mutex_);
+  cleared_ = true;
+  keyframes_.clear();
+  points_.clear();
+  points_moved_.clear();
+  masks_.clear();
+}
+
+void MapStoreWriter::onMapChanged(const MapChanges& changes) {
+  std::lock_guard lock(pending_mutex_);
+  for (const auto* ids :
+       {&changes.keyframes_created, &changes.keyframes_updated, &changes.keyframes_erased}) {
+    keyframes_.insert(ids->begin(), ids->end());
+  }
+  for (const auto* ids :
+       {&changes.points_created, &changes.points_updated, &changes.points_erased}) {
+    for (const MapPointId id : *ids) {
+      points_.insert(id);
+      points_moved_.erase(id);
+    }
+  }
+  // Bundle adjustment moves many points at a time: those are updated in place, not rewritten.
+  for (const MapPointId id : changes.points_moved) {
+    if (!points_.contains(id)) points_moved_.insert(id);
+  }
+}
+
+void MapStoreWriter::onMasks(const std::vector<MaskRecord>& masks) {
+  std::lock_guard lock(pending_mutex_);
+  masks_.insert(masks_.end(), masks.begin(), masks.end());
+}
+
+MapStoreBatch MapStoreWriter::takeBatch() {
+  MapStoreBatch batch;
+  std::unordered_set<KeyFrameId> keyframes;
+  std::unordered_set<MapPointId> points;
+  std::unordered_set<MapPointId> points_moved;
+  {
+    std::lock_guard lock(pending_mutex_);
+    batch.cleared = cleared_;
+    cleared_ = false;
+    keyframes.swap(keyframes_);
+    points.swap(points_);
+    points_moved.swap(points_moved_);
+    batch.masks.swap(masks_);
+  }
+  if (batch.cleared) stored_keyframes_.clear();
+  // What the map holds now decides: an element changed and then erased is erased.
+  std::lock_guard map_lock(map_.updateMutex());
+  for (const KeyFrameId id : keyframes) {
+    const KeyFrame* keyframe = map_.keyFrame(id);
+    if (keyframe == nullptr || keyframe->isBad()) {
+      if (stored_keyframes_.erase(id) > 0) batch.keyframes_erased.push_back(id);
+    } else if (stored_keyframes_.insert(id).second) {
+      batch.keyframes.push_back(keyFrameRecord(*keyframe));
+    } else {
+      batch.poses.push_back(keyFramePoseRecord(*keyframe));
+    }
+  }
+  for (const MapPointId id : points) {
+    const MapPoint* point = map_.mapPoint(id);
+    if (point == nullptr || point->isBad()) {
+      batch.points_erased.push_back(id);
+    } else {
+      batch.points.push_back(mapPointRecord(*point));
+    }
+  }
+  for (const MapPointId id : points_moved) {
+    const MapPoint* point = map_.mapPoint(id);
+    if (point == nullptr || point->isBad()) {
+      batch.points_erased.push_back(id);
+      continue;
+    }
+    MapPointRecord& moved = batch.points_moved.emplace_back();
+    moved.id = id;
+    moved.position = point->position();
+    moved.normal = point->normal();
+    moved.min_distance = point->baseMinDistance();
+    moved.max_distance = point->baseMaxDistance();
+  }
+  return batch;
+}
+
+void MapStoreWriter::flush() {
+  std::lock_guard writing(write_mutex_);
+  if (stopped_) return;
+  Stopwatch copy_timer;
+  MapStoreBatch batch = takeBatch();
+  const double copy_ms = copy_timer.elapsedMs();
+  if (batch.empty()) return;
+  Stopwatch write_timer;
+  try {
+    store_->write(session_, batch);
+    if (stats_) {
+      stats_->addBatch(batch.keyframes.size(), batch.points.size(), batch.points_moved.size(),
+                       copy_ms, write_timer.elapsedMs());
+    }
+  } catch (const std::exception& e) {
+    // The batch is lost (the transaction rolled back); later batches carry on so that at least
+    // what changes again is kept. The keyframes it would have stored are sent in full again.
+    for (const KeyFrameRecord& k : batch.keyframes) stored_keyframes_.erase(k.id);
+    if (stats_) stats_->addFailure();
+    spdlog::error("map store: {}", e.what());
+  }
+}
+
+void MapStoreWriter::run() {
+  std::unique_lock lock(pending_mutex_);
+  while (!stopping_) {
+    wake_.wait_for(lock, std::chrono::duration<double>(interval_s_), [this] { return stopping_; });
+    if (stopping_) break;
+    lock.unlock();
+    flush();
+    lock.lock();
+  }
+}
+
+void MapStoreWriter::stop() {
+  if (stats_) stats_->detach(this);
+  {
+    std::lock_guard lock(pending_mutex_);
+    if (stopping_) return;
+    stopping_ = true;
+  }
+  wake_.notify_all();
+  if (thread_.joinable()) thread_.join();
+  flush();
+  std::lock_guard writing(write_mutex_);
+  stopped_ = true;
+  try {
+    store_->endSession(session_);
+  } catch (const std::exception& e) {
+    spdlog::error("map store: {}", e.what());
+  }
+}
+
+}  // namespace edgeslam

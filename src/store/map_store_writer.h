@@ -1,0 +1,94 @@
+#pragma once
+// Writes one session's map into the store as it changes, off the mapping and tracking threads:
+// the changes noted (MapChangeObserver) are gathered and, about once a second, the map's current
+// state of what changed is copied under the map's mutex and written as one transaction on the
+// writer's own thread. A killed process loses at most the last interval.
+#include <condition_variable>
+#include <memory>
+#include <mutex>
+#include <thread>
+#include <unordered_set>
+#include <vector>
+
+#include "map/map.h"
+#include "map/map_change_observer.h"
+#include "store/map_store.h"
+#include "util/timing_stats.h"
+
+namespace edgeslam {
+
+class MapStoreWriter;
+
+// The writers of a process (shared by its sessions; thread-safe): what they wrote, and a way to
+// have every live one write what it has now (before a run reports its figures).
+class MapStoreWriteStats {
+ public:
+  void addBatch(std::size_t keyframes, std::size_t points, std::size_t points_moved, double copy_ms,
+                double write_ms);
+  void addFailure();
+  void attach(MapStoreWriter* writer);
+  void detach(MapStoreWriter* writer);
+  void flushAll();
+  struct Totals {
+    std::uint64_t batches = 0;
+    std::uint64_t keyframes_written = 0;
+    std::uint64_t points_written = 0;  // whole
+    std::uint64_t points_moved = 0;    // position updates only
+    std::uint64_t failures = 0;
+    PercentileSummary write_ms;  // per batch, the store's transaction
+    PercentileSummary copy_ms;   // per batch, the copy under the map's mutex
+  };
+  Totals totals() const;
+
+ private:
+  mutable std::mutex mutex_;
+  std::mutex writers_mutex_;  // guards writers_; held while they flush
+  std::vector<MapStoreWriter*> writers_;
+  Totals totals_;
+  SampleStats write_ms_;
+  SampleStats copy_ms_;
+};
+
+class MapStoreWriter : public MapChangeObserver {
+ public:
+  MapStoreWriter(std::shared_ptr<MapStore> store, StoreSessionId session, const Map& map,
+                 std::shared_ptr<MapStoreWriteStats> stats, double interval_s = 1.0);
+  ~MapStoreWriter() override;
+  MapStoreWriter(const MapStoreWriter&) = delete;
+  MapStoreWriter& operator=(const MapStoreWriter&) = delete;
+
+  void onMapCleared() override;
+  void onMapChanged(const MapChanges& changes) override;
+  void onMasks(const std::vector<MaskRecord>& masks) override;
+
+  // Writes what is pending now (on the caller's thread) and waits for it.
+  void flush();
+  // Writes the rest, marks the session ended and stops the thread. Call before the map goes.
+  void stop();
+
+ private:
+  void run();
+  MapStoreBatch takeBatch();
+
+  std::shared_ptr<MapStore> store_;
+  StoreSessionId session_;
+  const Map& map_;
+  std::shared_ptr<MapStoreWriteStats> stats_;
+  double interval_s_;
+
+  std::mutex pending_mutex_;
+  std::condition_variable wake_;
+  bool stopping_ = false;
+  bool cleared_ = false;
+  std::unordered_set<KeyFrameId> keyframes_;     // created, changed or erased since the last batch
+  std::unordered_set<MapPointId> points_;        // written whole
+  std::unordered_set<MapPointId> points_moved_;  // only moved (and not in points_)
+  std::vector<MaskRecord> masks_;
+
+  std::mutex write_mutex_;                           // one batch at a time
+  std::unordered_set<KeyFrameId> stored_keyframes_;  // guarded by write_mutex_
+  bool stopped_ = false;
+  std::thread thread_;
+};
+
+}  // namespace edgeslam

@@ -1,0 +1,40 @@
+#pragma once
+// The embedded map store: one SQLite database in WAL mode (a killed process never leaves a store
+// that does not open; each batch is one transaction). Thread-safe: calls are serialised by one
+// mutex, so the writers of several sessions share the store.
+#include <memory>
+#include <mutex>
+
+#include "store/map_store.h"
+#include "store/sqlite_database.h"
+
+namespace edgeslam {
+
+class SqliteMapStore : public MapStore {
+ public:
+  // `lock_fd`: the held lock file of a writing process (closed with the store), or -1.
+  SqliteMapStore(const std::filesystem::path& file, MapStoreAccess access, int lock_fd);
+  ~SqliteMapStore() override;
+
+  std::string location() const override { return db_.file().string(); }
+  std::vector<MapSummary> listMaps() override;
+  std::optional<MapSummary> mapInfo(const std::string& name) override;
+  std::optional<StoredMap> loadMap(const std::string& name) override;
+  StoreSessionId beginSession(const std::string& map, const StoredSessionInfo& info) override;
+  void write(StoreSessionId session, const MapStoreBatch& batch) override;
+  void endSession(StoreSessionId session) override;
+  bool removeMap(const std::string& name) override;
+
+ private:
+  struct Statements;
+  std::optional<std::int64_t> mapId(const std::string& name);
+  MapSummary summary(std::int64_t map_id, const std::string& name);
+  StoredSession loadSession(SqliteStatement& row);
+
+  std::mutex mutex_;
+  int lock_fd_;
+  SqliteDatabase db_;
+  std::unique_ptr<Statements> statements_;
+};
+
+}  // namespace edgeslam

@@ -1,0 +1,165 @@
+// The SQLite map store with a real (synthetic-scene) map: written through the writer as the map
+// changes, read back record for record, and loaded into a Map again.
+#include "store/map_store.h"
+
+#include <gtest/gtest.h>
+
+#include "map/map_replication.h"
+#include "store/map_store_writer.h"
+#include "store/store_error.h"
+#include "store/stored_map_loader.h"
+#include "store_fixture.h"
+
+namespace edgeslam {
+namespace {
+
+using test::freshStoreDir;
+using test::SmallMap;
+
+const StoredSession& onlySession(const StoredMap& map) {
+  EXPECT_EQ(map.sessions.size(), 1u);
+  return map.sessions.front();
+}
+
+TEST(MapStore, RoundTripKeepsKeyFramesPointsAndObservations) {
+  const auto dir = freshStoreDir("roundtrip");
+  SmallMap small;
+  {
+    std::shared_ptr<MapStore> store = openMapStore(dir, MapStoreAccess::kServe);
+    const StoreSessionId session = store->beginSession("kitchen", small.info());
+    auto stats = std::make_shared<MapStoreWriteStats>();
+    MapStoreWriter writer(store, session, small.map, stats);
+    {
+      std::lock_guard lock(small.map.updateMutex());
+      writer.onMapChanged(small.map.takeChanges());
+    }
+    writer.stop();
+    EXPECT_EQ(stats->totals().keyframes_written, 3u);
+    EXPECT_EQ(stats->totals().points_written, small.map.pointCount());
+  }
+  auto store = openMapStore(dir, MapStoreAccess::kRead);
+  const auto info = store->mapInfo("kitchen");
+  ASSERT_TRUE(info);
+  EXPECT_EQ(info->keyframes, 3u);
+  EXPECT_EQ(info->points, small.map.pointCount());
+  EXPECT_EQ(info->sessions, 1u);
+  EXPECT_GT(info->bytes, 3u * 32u * 50u);
+  const auto stored = store->loadMap("kitchen");
+  ASSERT_TRUE(stored);
+  const StoredSession& session = onlySession(*stored);
+  EXPECT_GT(session.ended, 0.0);
+  EXPECT_EQ(session.info.sensor, Sensor::kRgbd);
+  EXPECT_DOUBLE_EQ(session.info.camera.fx(), small.scene.camera().fx());
+  ASSERT_EQ(session.keyframes.size(), 3u);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const KeyFrameRecord& k = session.keyframes[i];
+    const KeyFrame& original = *small.keyframes[i];
+    EXPECT_EQ(k.id, original.id());
+    EXPECT_EQ(k.frame_index, original.frameIndex());
+    EXPECT_LT((k.T_cw.translation() - original.pose().translation()).norm(), 1e-12);
+    EXPECT_LT(k.T_cw.rotation().angularDistance(original.pose().rotation()), 1e-9);
+    ASSERT_EQ(k.features.keypoints.size(), original.features().keypoints.size());
+    EXPECT_EQ(k.features.keypoints[5].pt, original.features().keypoints[5].pt);
+    EXPECT_EQ(k.features.keypoints[5].octave, original.features().keypoints[5].octave);
+    EXPECT_EQ(cv::norm(k.features.descriptors, original.features().descriptors, cv::NORM_HAMMING),
+              0.0);
+    EXPECT_EQ(k.features.depth, original.features().depth);
+    for (std::size_t j = 0; j < original.size(); ++j) {
+      const MapPoint* p = original.point(j);
+      EXPECT_EQ(k.point_ids[j], p != nullptr ? p->id() : kInvalidId);
+    }
+  }
+  ASSERT_EQ(session.points.size(), small.map.pointCount());
+  for (const MapPointRecord& p : session.points) {
+    const MapPoint* original = small.map.mapPoint(p.id);
+    ASSERT_NE(original, nullptr);
+    EXPECT_EQ(p.position, original->position());
+    EXPECT_EQ(p.observations.size(), original->observations().size());
+  }
+
+  // And into a Map again, as a server would hold it: covisibility rebuilt from the points.
+  Map loaded;
+  loadStoredSession(session, loaded);
+  EXPECT_EQ(loaded.keyFrameCount(), 3u);
+  EXPECT_EQ(loaded.pointCount(), small.map.pointCount());
+  const KeyFrame* a = loaded.keyFrame(small.keyframes[0]->id());
+  const KeyFrame* b = loaded.keyFrame(small.keyframes[1]->id());
+  ASSERT_NE(a, nullptr);
+  ASSERT_NE(b, nullptr);
+  EXPECT_EQ(a->weight(const_cast<KeyFrame*>(b)), small.keyframes[0]->weight(small.keyframes[1]));
+  EXPECT_GT(a->weight(const_cast<KeyFrame*>(b)), 10);
+  // New ids continue after the loaded ones.
+  EXPECT_GT(loaded.ids().next(), small.map.mapPoints().back()->id());
+  std::filesystem::remove_all(dir);
+}
+
+TEST(MapStore, LaterBatchesUpdatePosesAndEraseWhatTheMapErased) {
+  const auto dir = freshStoreDir("updates");
+  SmallMap small;
+  std::shared_ptr<MapStore> store = openMapStore(dir, MapStoreAccess::kServe);
+  const StoreSessionId session = store->beginSession("m", small.info());
+  MapStoreWriter writer(store, session, small.map, nullptr);
+  const auto take = [&] {
+    std::lock_guard lock(small.map.updateMutex());
+    writer.onMapChanged(small.map.takeChanges());
+  };
+  take();
+  writer.flush();
+  KeyFrame* moved = small.keyframes[2];
+  const SE3d corrected(Eigen::Quaterniond::Identity(), Eigen::Vector3d(1, 2, 3));
+  MapPoint* doomed = small.keyframes[0]->goodPoints().front();
+  const MapPointId doomed_id = doomed->id();
+  small.map.setKeyFramePose(moved, corrected);
+  small.map.erasePoint(doomed);
+  MapPoint* shifted = small.keyframes[1]->goodPoints().back();
+  const Eigen::Vector3d shifted_to = shifted->position() + Eigen::Vector3d(0.5, 0, 0);
+  small.map.relocatePoint(shifted, shifted_to);
+  take();
+  writer.flush();
+  const StoredSession loaded = onlySession(*store->loadMap("m"));
+  EXPECT_EQ(loaded.points.size(), small.map.pointCount());
+  for (const MapPointRecord& p : loaded.points) {
+    EXPECT_NE(p.id, doomed_id);
+    if (p.id == shifted->id()) {
+      EXPECT_EQ(p.position, shifted_to);                                 // moved in place...
+      EXPECT_EQ(p.observations.size(), shifted->observations().size());  // ...the rest kept
+    }
+  }
+  EXPECT_EQ(loaded.keyframes[2].T_cw.translation(), Eigen::Vector3d(1, 2, 3));
+
+  // A failed start empties the session's map.
+  writer.onMapCleared();
+  writer.flush();
+  const StoredSession cleared = onlySession(*store->loadMap("m"));
+  EXPECT_TRUE(cleared.keyframes.empty());
+  EXPECT_TRUE(cleared.points.empty());
+  writer.stop();
+  std::filesystem::remove_all(dir);
+}
+
+TEST(MapStore, NamedMapsLiveSideBySideAndRemoveAlone) {
+  const auto dir = freshStoreDir("named");
+  SmallMap small;
+  auto store = openMapStore(dir, MapStoreAccess::kServe);
+  MapStoreBatch batch;
+  for (const KeyFrame* kf : small.map.keyFrames()) batch.keyframes.push_back(keyFrameRecord(*kf));
+  for (const MapPoint* p : small.map.mapPoints()) batch.points.push_back(mapPointRecord(*p));
+  store->write(store->beginSession("office", small.info()), batch);
+  store->write(store->beginSession("kitchen", small.info()), batch);
+  store->write(store->beginSession("kitchen", small.info()), batch);
+  const auto maps = store->listMaps();
+  ASSERT_EQ(maps.size(), 2u);
+  EXPECT_EQ(maps[0].name, "kitchen");
+  EXPECT_EQ(maps[0].sessions, 2u);
+  EXPECT_EQ(maps[0].keyframes, 6u);
+  EXPECT_EQ(maps[1].name, "office");
+  EXPECT_EQ(maps[1].keyframes, 3u);
+  EXPECT_TRUE(store->removeMap("kitchen"));
+  EXPECT_FALSE(store->removeMap("kitchen"));
+  EXPECT_FALSE(store->mapInfo("kitchen"));
+  EXPECT_EQ(store->mapInfo("office")->points, small.map.pointCount());
+  std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace edgeslam
