@@ -4,6 +4,7 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <exception>
+#include <iostream>
 #include <string>
 
 #include "commands.h"
@@ -13,6 +14,13 @@ namespace edgeslam::cli {
 int& exitCode() {
   static int code = 0;
   return code;
+}
+
+std::string oneLine(std::string message) {
+  std::replace_if(
+      message.begin(), message.end(), [](char c) { return c == '\n' || c == '\r'; }, ' ');
+  while (!message.empty() && message.back() == ' ') message.pop_back();
+  return message;
 }
 
 std::vector<RegisteredCommand>& registeredCommands() {
@@ -41,11 +49,17 @@ int main(int argc, char** argv) {
 
   try {
     app.parse(argc, argv);
+  } catch (const CLI::Success& e) {
+    return app.exit(e);  // --help, --version
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    // Every usage error (unknown option, failed check, contradictory flags) exits with the same
+    // code, whatever CLI11's own code for its kind; one line, so that scripts can show it.
+    std::cerr << "edgeslam: usage error: " << edgeslam::cli::oneLine(e.what())
+              << " (see edgeslam --help)" << std::endl;
+    return edgeslam::cli::kUsageExitCode;
   } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    return 1;
+    std::cerr << "edgeslam: error: " << edgeslam::cli::oneLine(e.what()) << std::endl;
+    return edgeslam::cli::kRuntimeExitCode;
   }
   return edgeslam::cli::exitCode();
 }

@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 
+#include "network_security_options.h"
 #include "pipeline/slam_system.h"
 
 namespace edgeslam::cli {
@@ -15,7 +16,8 @@ struct RunOptions {
   std::string sensor = "auto";  // mono|rgbd|stereo; auto = rgbd when the dataset has depth
   std::string mode = "edge";    // edge|local|offload
   std::string link = "none";
-  std::string server_address;  // `client`: the edge server; empty = embedded on loopback
+  std::string server_address;      // `client`: the edge server; empty = embedded on loopback
+  ClientSecurityOptions security;  // `client`: TLS and token
   bool adapt = true;
   bool semantic = false;
   std::filesystem::path models_dir;  // segmentation models; "" = the shared models folder

@@ -102,7 +102,7 @@ void segmentOne(Segmenter& segmenter, const fs::path& input, const fs::path& out
 
 void runSegment(const SegmentOptions& o) {
   if ((o.image.empty() ? 0 : 1) + (o.images.empty() ? 0 : 1) + (o.truth.empty() ? 0 : 1) != 1) {
-    throw std::invalid_argument(
+    throw CLI::ValidationError(
         "give exactly one of --image FILE, --images DIR or --truth GENERATED_SEQUENCE");
   }
   if (o.threads > 0) cv::setNumThreads(o.threads);
@@ -205,6 +205,8 @@ void addSegmentCommand(CLI::App& app) {
     try {
       runSegment(*options);
       exitCode() = 0;
+    } catch (const CLI::Error&) {
+      throw;  // a usage error: main() reports it
     } catch (const std::exception& e) {
       std::cerr << "edgeslam segment: error: " << e.what() << std::endl;
       exitCode() = 1;

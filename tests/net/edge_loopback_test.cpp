@@ -241,8 +241,9 @@ TEST_F(EdgeLoopback, OversizedMessageIsResourceExhaustedAndTheServerGoesOn) {
   const grpc::Status status = rawUpload(*stub, request);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << status.error_message();
 
-  upload.image_bytes.resize(1000);
-  request.mutable_upload()->set_image(std::string(1000, 'x'));
+  upload.image_bytes = test::sampleKeyFrameImage(1000);
+  request.mutable_upload()->set_image(
+      std::string(upload.image_bytes.begin(), upload.image_bytes.end()));
   const grpc::Status next = rawUpload(*stub, request);
   EXPECT_TRUE(next.ok()) << next.error_message();
   auto log = factory->session(0);

@@ -74,6 +74,15 @@ inline MapPointRecord samplePoint(std::uint64_t id, std::mt19937& rng) {
   return p;
 }
 
+// The header of a 320 x 240 grey JPEG (the sample camera halved), padded with zeros to `size`:
+// what the edge server reads before it accepts a keyframe image.
+inline std::vector<std::uint8_t> sampleKeyFrameImage(std::size_t size = 0) {
+  std::vector<std::uint8_t> bytes{0xff, 0xd8, 0xff, 0xc0, 0x00, 0x0b, 8,    0x00, 0xf0,
+                                  0x01, 0x40, 0x01, 0x01, 0x11, 0x00, 0xff, 0xd9};
+  if (bytes.size() < size) bytes.resize(size, 0);
+  return bytes;
+}
+
 inline KeyFrameUpload sampleUpload(std::uint64_t sequence, int keypoints, int new_points,
                                    std::mt19937& rng) {
   KeyFrameUpload u;
@@ -82,7 +91,7 @@ inline KeyFrameUpload sampleUpload(std::uint64_t sequence, int keypoints, int ne
   for (int i = 0; i < new_points; ++i)
     u.new_points.push_back(samplePoint(clientId(3, 50000 + i), rng));
   u.image_encoding = "jpeg";
-  u.image_bytes = {0xff, 0xd8, 0xff, 0xe0, 1, 2, 3};
+  u.image_bytes = sampleKeyFrameImage();
   u.acknowledged_slice = sequence > 1 ? sequence - 1 : 0;
   u.segmenter_nms = 0.7f;
   return u;
