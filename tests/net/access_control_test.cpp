@@ -13,6 +13,7 @@
 #include "net/access_tokens.h"
 #include "net/edge_client.h"
 #include "net/edge_server.h"
+#include "net/session_registry.h"
 #include "net/wire_convert.h"
 #include "net_test_records.h"
 
