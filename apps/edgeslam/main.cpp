@@ -3,8 +3,10 @@
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
+#include <cstdlib>
 #include <exception>
 #include <iostream>
+#include <opencv2/core/utils/logger.hpp>
 #include <string>
 
 #include "commands.h"
@@ -30,7 +32,28 @@ std::vector<RegisteredCommand>& registeredCommands() {
 
 }  // namespace edgeslam::cli
 
+namespace {
+
+// gRPC, OpenCV and FFmpeg print their own diagnostics on stderr for what edgeslam reports itself
+// in one line; they stay quiet unless asked for (--log-level debug or trace, or the libraries'
+// own variables, which win).
+void quietLibraries(int argc, char** argv) {
+  for (int i = 1; i + 1 < argc; ++i) {
+    const std::string option = argv[i];
+    const std::string value = argv[i + 1];
+    if (option == "--log-level" && (value == "debug" || value == "trace")) return;
+  }
+  setenv("GRPC_VERBOSITY", "NONE", /*overwrite=*/0);
+  setenv("OPENCV_FFMPEG_LOGLEVEL", "-8", 0);  // AV_LOG_QUIET
+  if (std::getenv("OPENCV_LOG_LEVEL") == nullptr) {
+    cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
+  }
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
+  quietLibraries(argc, argv);
   CLI::App app{
       "edgeslam: edge-assisted real-time semantic visual SLAM.\n"
       "Run `edgeslam SUBCOMMAND --help` for the options of each sub-command."};

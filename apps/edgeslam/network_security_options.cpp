@@ -33,6 +33,22 @@ void addServerSecurityOptions(CLI::App& command, ServerSecurityOptions& options)
       ->capture_default_str();
 }
 
+CLI::Validator listenAddress() {
+  return CLI::Validator(
+      [](std::string& value) -> std::string {
+        if (value.rfind("unix:", 0) == 0) return value.size() > 5 ? "" : "unix: needs a path";
+        const std::size_t colon = value.rfind(':');
+        if (colon == std::string::npos || colon == 0) return "expected HOST:PORT, got " + value;
+        const std::string port = value.substr(colon + 1);
+        if (port.empty() || port.size() > 5 ||
+            port.find_first_not_of("0123456789") != std::string::npos || std::stoi(port) > 65535) {
+          return "the port of " + value + " is not a number in 0..65535";
+        }
+        return "";
+      },
+      "HOST:PORT", "listen address");
+}
+
 EdgeServerSecurity loadServerSecurity(const ServerSecurityOptions& options,
                                       const std::string& listen_address) {
   const bool tls = !options.tls_cert.empty();

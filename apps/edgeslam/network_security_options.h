@@ -21,6 +21,9 @@ struct ServerSecurityOptions {
 
 void addServerSecurityOptions(CLI::App& command, ServerSecurityOptions& options);
 
+// Checks a --listen value: HOST:PORT with a port in 0..65535, [IPV6]:PORT, or unix:PATH.
+CLI::Validator listenAddress();
+
 // Refuses (CLI::ValidationError: a usage error) to serve an address off loopback without TLS and
 // tokens unless --insecure; reads the files (std::runtime_error when they are unreadable).
 EdgeServerSecurity loadServerSecurity(const ServerSecurityOptions& options,

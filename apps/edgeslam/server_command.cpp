@@ -82,6 +82,7 @@ void addServerCommand(CLI::App& app) {
   cmd->add_option("--listen", o->listen,
                   "HOST:PORT to listen on (port 0 = any free port); an address off loopback needs "
                   "--tls-cert, --tls-key and --auth-tokens, or --insecure")
+      ->check(listenAddress())
       ->capture_default_str();
   cmd->add_option("--status-every", o->status_interval_s,
                   "Seconds between session status lines (0 = none)");

@@ -164,8 +164,19 @@ std::vector<BadInvocation> sweep(const BadInputs& in) {
       {"server --status-every often", kUsage},
       {"server --semantic perhaps", kUsage},
       {"server --listen 127.0.0.1:0 --vocab " + in.path("garbage.vocab"), kRuntime},
-      {"server --listen 999.1.1.1:5 --vocab none --semantic off", kRuntime},
-      {"server --listen not-an-address --vocab none --semantic off", kRuntime},
+      {"server --listen 127.0.0.1:99999 --vocab none --semantic off", kUsage},
+      {"server --listen 127.0.0.1:port --vocab none --semantic off", kUsage},
+      {"server --listen 127.0.0.1 --vocab none --semantic off", kUsage},
+      {"server --listen 0.0.0.0:0 --vocab none --semantic off", kUsage},  // no TLS off loopback
+      {"server --tls-cert " + in.path("garbage.yaml"), kUsage},           // --tls-key missing
+      {"server --listen 127.0.0.1:0 --tls-cert " + in.path("garbage.yaml") + " --tls-key " +
+           in.path("garbage.yaml") + " --vocab none --semantic off",
+       kRuntime},  // not PEM
+      {"server --listen 127.0.0.1:0 --auth-tokens " + in.path("empty.txt") +
+           " --vocab none --semantic off",
+       kRuntime},
+      {"client --dataset " + tum + " --server 127.0.0.1:1 --tls-ca " + in.path("missing.pem") + out,
+       kRuntime},
       // linkem
       {"linkem --listen 127.0.0.1:0", kUsage},
       {"linkem --listen 127.0.0.1:0 --target 127.0.0.1:1 --profile dialup", kUsage},

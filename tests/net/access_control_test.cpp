@@ -207,13 +207,13 @@ TEST_F(AccessControl, SessionsPerTokenAreLimited) {
 TEST_F(AccessControl, UnusedSessionsDoNotLockOthersOut) {
   EdgeServerLimits limits;
   limits.max_sessions = 4;
-  limits.reclaim_idle_after = 300ms;
+  limits.reclaim_idle_after = 1000ms;
   limits.max_sessions_per_client = 255;
   startServer(limits);
   for (int i = 0; i < 4; ++i) ASSERT_TRUE(open(kAlice).ok());
   // Full, and every session was used just now: refused.
   EXPECT_EQ(open(kBob, "lab").error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED);
-  std::this_thread::sleep_for(500ms);
+  std::this_thread::sleep_for(1500ms);
   // The idle ones make room, one at a time, long before the idle timeout (60 s).
   EXPECT_TRUE(open(kBob, "lab").ok());
   EXPECT_EQ(server_->sessionCount(), 4U);
