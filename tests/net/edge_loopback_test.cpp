@@ -167,7 +167,7 @@ TEST_F(EdgeLoopback, TwoSessionsGetDistinctOrigins) {
 
 TEST_F(EdgeLoopback, OffloadFrameReturnsThePose) {
   EdgeClient client(server->address(), test::sampleSessionConfig(), clientOptions());
-  const auto result = client.offloadFrame({41, 1.5, "jpeg", {1, 2, 3}, "", {}});
+  const auto result = client.offloadFrame({41, 1.5, "jpeg", test::sampleFrameImage(), "", {}});
   ASSERT_TRUE(result.has_value());
   EXPECT_EQ(result->frame_index, 41u);
   EXPECT_EQ(result->state, OffloadTrackingState::kOk);
@@ -182,7 +182,7 @@ TEST(EdgeServerOffload, BackendWithoutOffloadAnswersUnimplemented) {
   options.connect_timeout = 10s;
   EdgeClient client(server.address(), test::sampleSessionConfig(), options);
   try {
-    client.offloadFrame({1, 0.0, "png", {1}, "", {}});
+    client.offloadFrame({1, 0.0, "jpeg", test::sampleFrameImage(), "", {}});
     ADD_FAILURE() << "no error";
   } catch (const EdgeClientError& e) {
     EXPECT_THAT(e.what(), HasSubstr("do not track whole frames"));

@@ -1,6 +1,8 @@
 #pragma once
 // Sample wire records for the net tests: every field set to something non-default, so a field
 // lost in either direction of a conversion shows.
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
 
@@ -77,10 +79,19 @@ inline MapPointRecord samplePoint(std::uint64_t id, std::mt19937& rng) {
 // The header of a 320 x 240 grey JPEG (the sample camera halved), padded with zeros to `size`:
 // what the edge server reads before it accepts a keyframe image.
 inline std::vector<std::uint8_t> sampleKeyFrameImage(std::size_t size = 0) {
-  std::vector<std::uint8_t> bytes{0xff, 0xd8, 0xff, 0xc0, 0x00, 0x0b, 8,    0x00, 0xf0,
-                                  0x01, 0x40, 0x01, 0x01, 0x11, 0x00, 0xff, 0xd9};
-  if (bytes.size() < size) bytes.resize(size, 0);
+  constexpr std::array<std::uint8_t, 17> kHeader{0xff, 0xd8, 0xff, 0xc0, 0x00, 0x0b,
+                                                 8,    0x00, 0xf0, 0x01, 0x40, 0x01,
+                                                 0x01, 0x11, 0x00, 0xff, 0xd9};
+  std::vector<std::uint8_t> bytes(std::max(size, kHeader.size()), 0);
+  std::copy(kHeader.begin(), kHeader.end(), bytes.begin());
   return bytes;
+}
+
+// The header of a 640 x 480 grey JPEG: an offloaded frame of the sample camera, as far as the
+// edge server's checks read it.
+inline std::vector<std::uint8_t> sampleFrameImage() {
+  return {0xff, 0xd8, 0xff, 0xc0, 0x00, 0x0b, 8,    0x01, 0xe0,
+          0x02, 0x80, 0x01, 0x01, 0x11, 0x00, 0xff, 0xd9};
 }
 
 inline KeyFrameUpload sampleUpload(std::uint64_t sequence, int keypoints, int new_points,
