@@ -13,6 +13,7 @@ DEMO_ARGS ?=
 export EDGESLAM_SHARED
 
 .PHONY: all deps configure build vocab test test-release test-sanitize test-tsan test-host-timing demo bench format format-check clean
+.PHONY: fuzz
 
 all: build
 
@@ -69,6 +70,18 @@ test-tsan: deps
 test: test-release
 	@if [ -n "$$CI" ]; then $(MAKE) --no-print-directory test-sanitize test-tsan; fi
 
+# libFuzzer harnesses (tests/fuzz) built by clang with ASan into $(FUZZ_DIR), each run for
+# FUZZ_SECONDS on a corpus kept in $(FUZZ_DIR)/fuzz-corpus, seeded from real messages and files;
+# prints executions per harness and fails on any crash (saved in $(FUZZ_DIR)/fuzz-crashes).
+FUZZ_DIR ?= build-fuzz
+FUZZ_SECONDS ?= 20
+fuzz: deps
+	@cmake -S . -B $(FUZZ_DIR) -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	  -DCMAKE_CXX_COMPILER=/usr/bin/clang++ -DEDGESLAM_FUZZ=ON -DEDGESLAM_BUILD_TESTS=OFF \
+	  -DEDGESLAM_BUILD_BENCH=OFF -DEDGESLAM_WERROR=OFF -DEDGESLAM_SHARED_DIR=$(EDGESLAM_SHARED) > /dev/null
+	@cmake --build $(FUZZ_DIR) -j $(JOBS) --target edgeslam_fuzzers
+	@FUZZ_DIR=$(FUZZ_DIR) FUZZ_SECONDS=$(FUZZ_SECONDS) bash scripts/fuzz.sh
+
 demo: vocab
 	@./$(BUILD_DIR)/edgeslam run --dataset "$(EDGESLAM_DATA)" --mode edge --out $(DEMO_OUT) $(DEMO_ARGS)
 
@@ -87,4 +100,4 @@ format-check:
 	@git ls-files '*.cpp' '*.h' | xargs clang-format --dry-run --Werror
 
 clean:
-	rm -rf $(BUILD_DIR) $(ASAN_DIR)
+	rm -rf $(BUILD_DIR) $(ASAN_DIR) $(FUZZ_DIR)

@@ -9,6 +9,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libspdlog-dev libfmt-dev libcli11-dev nlohmann-json3-dev libyaml-cpp-dev libzstd-dev
   libcpp-httplib-dev libsqlite3-dev
+  openssl zlib1g-dev
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -127,6 +127,8 @@ void addDatasetCommands(CLI::App& app) {
     try {
       runInfo(*options);
       exitCode() = 0;
+    } catch (const CLI::Error&) {
+      throw;  // a usage error: main() reports it
     } catch (const std::exception& e) {
       std::cerr << "edgeslam dataset info: error: " << e.what() << std::endl;
       exitCode() = 1;

@@ -171,6 +171,8 @@ std::function<void()> guarded(const std::string& name, std::function<void()> bod
     try {
       body();
       exitCode() = 0;
+    } catch (const CLI::Error&) {
+      throw;  // a usage error: main() reports it
     } catch (const std::exception& e) {
       std::cerr << "edgeslam eval " << name << ": error: " << e.what() << std::endl;
       exitCode() = 1;

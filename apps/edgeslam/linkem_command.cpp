@@ -166,6 +166,8 @@ void addLinkemCommand(CLI::App& app) {
     try {
       runLinkem(*o);
       exitCode() = 0;
+    } catch (const CLI::Error&) {
+      throw;  // a usage error: main() reports it
     } catch (const std::exception& e) {
       std::cerr << "edgeslam linkem: error: " << e.what() << std::endl;
       exitCode() = 1;

@@ -150,10 +150,13 @@ std::unique_ptr<SlamSystem> makeSlamSystem(const RunOptions& options, const std:
   if (mode == "local") return std::make_unique<LocalSlam>(camera, slam_options);
   const SessionConfig config = sessionConfig(camera, sensor, slam_options, options);
   if (mode == "offload") {
-    return std::make_unique<OffloadSlam>(sensor,
-                                         std::make_unique<EdgeClient>(edge.address, config));
+    EdgeClientOptions offload_options;
+    offload_options.credentials = loadClientCredentials(options.security);
+    return std::make_unique<OffloadSlam>(
+        sensor, std::make_unique<EdgeClient>(edge.address, config, offload_options));
   }
   EdgeClientOptions client_options;
+  client_options.credentials = loadClientCredentials(options.security);
   client_options.keyframe_image.downscale = options.segment_reduce;
   client_options.omit_known_point_descriptors = options.omit_known_point_descriptors;
   auto link = std::make_unique<GrpcEdgeLink>(edge.address, config, client_options);
@@ -726,9 +729,10 @@ void addClientCommand(CLI::App& app) {
       "client", "The mobile client alone, against an edge server (`edgeslam server`)");
   addRunOptions(client, options);
   client->add_option("--server", options->server_address, "Edge server HOST:PORT")->required();
+  addClientSecurityOptions(*client, options->security);
   client->callback([options] {
     if (options->mode == "local") {
-      throw std::invalid_argument("edgeslam client needs --mode edge or offload");
+      throw CLI::ValidationError("--mode", "edgeslam client needs --mode edge or offload");
     }
     exitCode() = runPipeline(*options);
   });

@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 
+#include "network_security_options.h"
 #include "pipeline/slam_system.h"
 
 namespace edgeslam::cli {
@@ -15,9 +16,10 @@ struct RunOptions {
   std::string sensor = "auto";  // mono|rgbd|stereo; auto = rgbd when the dataset has depth
   std::string mode = "edge";    // edge|local|offload
   std::string link = "none";
-  std::string server_address;  // `client`: the edge server; empty = embedded on loopback
-  std::string maps;            // the embedded edge's map store: "" = default, "none" = none
-  std::string map_name;        // the edge map this session writes into; "" = a new one
+  std::string server_address;      // `client`: the edge server; empty = embedded on loopback
+  ClientSecurityOptions security;  // `client`: TLS and token
+  std::string maps;                // the embedded edge's map store: "" = default, "none" = none
+  std::string map_name;            // the edge map this session writes into; "" = a new one
   bool adapt = true;
   bool semantic = false;
   std::filesystem::path models_dir;  // segmentation models; "" = the shared models folder

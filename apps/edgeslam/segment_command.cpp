@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <memory>
 #include <opencv2/core/utility.hpp>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "commands.h"
+#include "net/image_header.h"
 #include "segment_truth_score.h"
 #include "semantic/coco_classes.h"
 #include "semantic/label_encoding.h"
@@ -67,6 +69,17 @@ std::vector<fs::path> listImages(const fs::path& folder) {
 
 void segmentOne(Segmenter& segmenter, const fs::path& input, const fs::path& output,
                 const SegmentOptions& o) {
+  // The header first: a file that is no image fails here, before the decoders print their own
+  // complaints on stderr.
+  std::ifstream file(input, std::ios::binary);
+  std::vector<std::uint8_t> head(4096);
+  file.read(reinterpret_cast<char*>(head.data()), static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<std::size_t>(file.gcount()));
+  std::string header_error;
+  if (!file.is_open() || !readImageHeader(head, &header_error)) {
+    throw std::runtime_error("cannot read image " + input.string() +
+                             (file.is_open() ? ": " + header_error : ""));
+  }
   cv::Mat image = cv::imread(input.string(), cv::IMREAD_COLOR);
   if (image.empty()) throw std::runtime_error("cannot read image " + input.string());
   if (o.reduce > 1) {
@@ -102,7 +115,7 @@ void segmentOne(Segmenter& segmenter, const fs::path& input, const fs::path& out
 
 void runSegment(const SegmentOptions& o) {
   if ((o.image.empty() ? 0 : 1) + (o.images.empty() ? 0 : 1) + (o.truth.empty() ? 0 : 1) != 1) {
-    throw std::invalid_argument(
+    throw CLI::ValidationError(
         "give exactly one of --image FILE, --images DIR or --truth GENERATED_SEQUENCE");
   }
   if (o.threads > 0) cv::setNumThreads(o.threads);
@@ -205,6 +218,8 @@ void addSegmentCommand(CLI::App& app) {
     try {
       runSegment(*options);
       exitCode() = 0;
+    } catch (const CLI::Error&) {
+      throw;  // a usage error: main() reports it
     } catch (const std::exception& e) {
       std::cerr << "edgeslam segment: error: " << e.what() << std::endl;
       exitCode() = 1;

@@ -10,6 +10,7 @@
 
 #include "commands.h"
 #include "map_store_option.h"
+#include "network_security_options.h"
 #include "pipeline/slam_session_backend.h"
 #include "segmenter_option.h"
 #include "vocabulary_option.h"
@@ -24,16 +25,19 @@ void requestStop(int) {
 }
 
 struct ServerOptions {
-  std::string listen = "0.0.0.0:50051";
+  std::string listen = "127.0.0.1:50051";
   int status_interval_s = 10;
   std::string vocabulary;
   std::string semantic = "auto";
   std::filesystem::path models_dir;
   int segment_input = 256;
   std::string maps;
+  ServerSecurityOptions security;
 };
 
 int runServer(const ServerOptions& o) {
+  // First: a server that would be open to the network does not start at all.
+  EdgeServerSecurity security = loadServerSecurity(o.security, o.listen);
   SlamSessionOptions options;
   options.mapping.vocabulary = loadVocabulary(o.vocabulary);
   if (o.semantic != "off") {
@@ -60,7 +64,8 @@ int runServer(const ServerOptions& o) {
   }
   const std::string& listen = o.listen;
   const int status_interval_s = o.status_interval_s;
-  EdgeServer server(listen, std::make_shared<SlamSessionFactory>(options));
+  EdgeServer server(listen, std::make_shared<SlamSessionFactory>(options), serverLimits(o.security),
+                    std::move(security));
   spdlog::info("edge server listening on {} (Ctrl-C to stop)", server.address());
   std::signal(SIGINT, requestStop);
   std::signal(SIGTERM, requestStop);
@@ -85,7 +90,11 @@ int runServer(const ServerOptions& o) {
 void addServerCommand(CLI::App& app) {
   auto o = std::make_shared<ServerOptions>();
   auto* cmd = app.add_subcommand("server", "The edge server: global maps for many client sessions");
-  cmd->add_option("--listen", o->listen, "HOST:PORT to listen on (port 0 = any free port)");
+  cmd->add_option("--listen", o->listen,
+                  "HOST:PORT to listen on (port 0 = any free port); an address off loopback needs "
+                  "--tls-cert, --tls-key and --auth-tokens, or --insecure")
+      ->check(listenAddress())
+      ->capture_default_str();
   cmd->add_option("--status-every", o->status_interval_s,
                   "Seconds between session status lines (0 = none)");
   cmd->add_option("--vocab", o->vocabulary,
@@ -100,6 +109,7 @@ void addServerCommand(CLI::App& app) {
   cmd->add_option("--models", o->models_dir,
                   "Segmentation models folder (default: the shared models)");
   addMapsOption(cmd, o->maps);
+  addServerSecurityOptions(*cmd, o->security);
   cmd->callback([o] { exitCode() = runServer(*o); });
 }
 

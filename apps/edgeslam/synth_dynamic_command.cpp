@@ -126,6 +126,8 @@ void addSynthDynamicCommand(CLI::App& app) {
     try {
       runSynthDynamic(*options);
       exitCode() = 0;
+    } catch (const CLI::Error&) {
+      throw;  // a usage error: main() reports it
     } catch (const std::exception& e) {
       std::cerr << "edgeslam synth-dynamic: error: " << e.what() << std::endl;
       exitCode() = 1;

@@ -154,6 +154,8 @@ void setCallback(CLI::App* command, const char* name, std::shared_ptr<Options> o
     try {
       run(*options);
       exitCode() = 0;
+    } catch (const CLI::Error&) {
+      throw;  // a usage error: main() reports it
     } catch (const std::exception& e) {
       std::cerr << "edgeslam vocab " << name << ": error: " << e.what() << std::endl;
       exitCode() = 1;
@@ -179,12 +181,17 @@ void addVocabCommands(CLI::App& app) {
       ->required()
       ->expected(1, -1);
   train->add_option("--out", train_options->out, "Vocabulary file to write")->required();
-  train->add_option("--k", train_options->k, "Branching factor")->capture_default_str();
+  train->add_option("--k", train_options->k, "Branching factor")
+      ->check(CLI::Range(2, 256))
+      ->capture_default_str();
   train->add_option("--levels", train_options->levels, "Depth of the tree (L)")
+      ->check(CLI::Range(1, 16))
       ->capture_default_str();
   train->add_option("--features", train_options->features, "ORB features per image")
+      ->check(CLI::Range(1, 100000))
       ->capture_default_str();
   train->add_option("--threads", train_options->threads, "Threads (0: all hardware threads)")
+      ->check(CLI::Range(0, 1024))
       ->capture_default_str();
   train->add_option("--seed", train_options->seed, "Random seed (the result depends on it only)")
       ->capture_default_str();
@@ -193,6 +200,7 @@ void addVocabCommands(CLI::App& app) {
                    "Use at most this many images, spread evenly over the list (0: all)")
       ->capture_default_str();
   train->add_option("--iterations", train_options->iterations, "k-medians rounds per node")
+      ->check(CLI::Range(1, 1000000))
       ->capture_default_str();
   train->add_option("--weighting", train_options->weighting, "Word weighting")
       ->check(CLI::IsMember({"tf-idf", "tf", "idf", "binary"}))

@@ -13,6 +13,7 @@
 
 #include "edgeslam/v1/edgeslam.grpc.pb.h"
 #include "net/channel_options.h"
+#include "net/server_security.h"
 #include "net/wire_convert.h"
 
 namespace edgeslam {
@@ -33,7 +34,16 @@ bool isPermanent(grpc::StatusCode code) {
   return code == grpc::StatusCode::INVALID_ARGUMENT ||
          code == grpc::StatusCode::RESOURCE_EXHAUSTED ||
          code == grpc::StatusCode::FAILED_PRECONDITION || code == grpc::StatusCode::UNIMPLEMENTED ||
-         code == grpc::StatusCode::INTERNAL;
+         code == grpc::StatusCode::INTERNAL || code == grpc::StatusCode::UNAUTHENTICATED ||
+         code == grpc::StatusCode::PERMISSION_DENIED;
+}
+
+std::shared_ptr<grpc::ChannelCredentials> channelCredentials(
+    const EdgeClientCredentials& credentials) {
+  if (credentials.tls_ca_pem.empty()) return grpc::InsecureChannelCredentials();
+  grpc::SslCredentialsOptions tls;
+  tls.pem_root_certs = credentials.tls_ca_pem;
+  return grpc::SslCredentials(tls);
 }
 
 class Backoff {
@@ -62,15 +72,18 @@ struct EdgeClient::Impl {
     encode_options.keypoint_response = options.send_keypoint_response;
     encode_options.omit_known_point_descriptors = options.omit_known_point_descriptors;
     channel = grpc::CreateCustomChannel(
-        address, grpc::InsecureChannelCredentials(),
+        address, channelCredentials(options.credentials),
         clientChannelArguments(options.max_receive_message_bytes,
                                static_cast<int>(options.backoff_max.count())));
     stub = v1::EdgeSlam::NewStub(channel);
     if (!channel->WaitForConnected(deadlineIn(options.connect_timeout))) {
       throw EdgeClientError(
           fmt::format("edge server at '{}' is not reachable (no connection within "
-                      "{} ms): is it running, and is the address right?",
-                      address, options.connect_timeout.count()));
+                      "{} ms): is it running, and is the address right{}?",
+                      address, options.connect_timeout.count(),
+                      options.credentials.tls_ca_pem.empty()
+                          ? ""
+                          : ", and does its TLS certificate match the CA and the address"));
     }
     if (const grpc::Status status = openSession(options.connect_timeout); !status.ok()) {
       throw EdgeClientError(
@@ -83,6 +96,13 @@ struct EdgeClient::Impl {
   ~Impl() { close(); }
 
   // --- session ---------------------------------------------------------------------------------
+
+  // Every call carries the client's token (when it has one).
+  void authorize(grpc::ClientContext& context) const {
+    if (!options.credentials.token.empty()) {
+      context.AddMetadata(kAuthorizationMetadataKey, "Bearer " + options.credentials.token);
+    }
+  }
 
   v1::RequestHeader header() const {
     v1::RequestHeader h;
@@ -99,6 +119,7 @@ struct EdgeClient::Impl {
     request.mutable_header()->set_protocol_version(kWireProtocolVersion);
     v1::OpenSessionReply reply;
     grpc::ClientContext context;
+    authorize(context);
     context.set_deadline(deadlineIn(timeout));
     const grpc::Status status = stub->OpenSession(&context, request, &reply);
     if (!status.ok()) return status;
@@ -195,6 +216,7 @@ struct EdgeClient::Impl {
     *request.mutable_header() = header();
     v1::CloseSessionReply reply;
     grpc::ClientContext context;
+    authorize(context);
     context.set_deadline(deadlineIn(options.close_timeout));
     if (stub->CloseSession(&context, request, &reply).ok()) {
       uplink += request.ByteSizeLong();
@@ -301,6 +323,7 @@ struct EdgeClient::Impl {
       request.mutable_upload()->set_acknowledged_slice(
           std::max(request.upload().acknowledged_slice(), last_applied.load()));
       grpc::ClientContext context;
+      authorize(context);
       context.set_deadline(deadlineIn(options.rpc_timeout));
       {
         std::lock_guard lock(mutex);
@@ -351,6 +374,7 @@ struct EdgeClient::Impl {
       request.set_from_sequence(last_applied.load() + 1);
       request.set_want_full_resync(resync_pending.load());
       grpc::ClientContext context;
+      authorize(context);
       {
         std::lock_guard lock(mutex);
         if (stopping) return;
@@ -496,6 +520,7 @@ std::optional<ProbeResult> EdgeClient::probe(std::size_t payload_bytes, std::siz
   request.set_reply_bytes(reply_bytes);
   v1::ProbeReply reply;
   grpc::ClientContext context;
+  impl_->authorize(context);
   context.set_deadline(deadlineIn(timeout.value_or(impl_->options.rpc_timeout)));
   const auto start = Clock::now();
   const grpc::Status status = impl_->stub->Probe(&context, request, &reply);
@@ -524,6 +549,7 @@ std::optional<OffloadResult> EdgeClient::offloadFrame(const OffloadFrame& frame)
     *request.mutable_header() = impl_->header();
     v1::OffloadFrameReply reply;
     grpc::ClientContext context;
+    impl_->authorize(context);
     context.set_deadline(deadlineIn(impl_->options.rpc_timeout));
     const grpc::Status status = impl_->stub->OffloadFrame(&context, request, &reply);
     if (status.ok()) {

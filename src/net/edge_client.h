@@ -35,7 +35,14 @@ struct EdgeSessionEvent {
   std::string reason;
 };
 
+// How the client proves itself to the server and checks the server (server_security.h).
+struct EdgeClientCredentials {
+  std::string tls_ca_pem;  // non-empty: TLS, the server's certificate checked against this CA
+  std::string token;       // non-empty: sent with every call as `authorization: Bearer TOKEN`
+};
+
 struct EdgeClientOptions {
+  EdgeClientCredentials credentials;
   std::chrono::milliseconds connect_timeout{3000};
   std::chrono::milliseconds rpc_timeout{5000};
   std::chrono::milliseconds close_timeout{500};

@@ -13,27 +13,44 @@
 
 namespace edgeslam {
 
+namespace {
+
+std::shared_ptr<grpc::ServerCredentials> serverCredentials(const EdgeServerSecurity& security) {
+  if (!security.tls()) return grpc::InsecureServerCredentials();
+  grpc::SslServerCredentialsOptions options;
+  options.pem_key_cert_pairs.push_back(
+      {security.tls_private_key_pem, security.tls_certificate_pem});
+  return grpc::SslServerCredentials(options);
+}
+
+}  // namespace
+
 struct EdgeServer::Impl {
   Impl(const std::string& listen_address, std::shared_ptr<EdgeSessionFactory> session_factory,
-       EdgeServerLimits server_limits)
+       EdgeServerLimits server_limits, EdgeServerSecurity security)
       : limits(server_limits),
         registry(server_limits.max_sessions,
                  SliceQueueLimits{server_limits.max_kept_slices, server_limits.max_kept_slice_bytes,
-                                  server_limits.max_send_message_bytes}),
-        service(registry, std::move(session_factory), server_limits) {
+                                  server_limits.max_send_message_bytes},
+                 server_limits.reclaim_idle_after),
+        service(registry, std::move(session_factory), server_limits, security.tokens) {
     grpc::ServerBuilder builder;
-    builder.AddListeningPort(listen_address, grpc::InsecureServerCredentials(), &bound_port);
+    builder.AddListeningPort(listen_address, serverCredentials(security), &bound_port);
     builder.RegisterService(&service);
     applyServerChannelOptions(builder, limits.max_message_bytes, limits.max_send_message_bytes);
     server = builder.BuildAndStart();
     if (server == nullptr || bound_port == 0) {
       throw std::runtime_error(fmt::format(
-          "edge server: cannot listen at '{}' (address in use or malformed?)", listen_address));
+          "edge server: cannot listen at '{}' (address in use or malformed{}?)", listen_address,
+          security.tls() ? ", or the TLS certificate and key do not match" : ""));
     }
     const std::size_t colon = listen_address.rfind(':');
     host = colon == std::string::npos ? listen_address : listen_address.substr(0, colon);
     reaper = std::thread([this] { reapIdleSessions(); });
-    spdlog::info("edge server: listening at {}:{}", host, bound_port);
+    spdlog::info("edge server: listening at {}:{} ({}, {})", host, bound_port,
+                 security.tls() ? "TLS" : "plaintext",
+                 security.tokens ? fmt::format("{} client token(s)", security.tokens->size())
+                                 : std::string("no client tokens"));
   }
 
   void reapIdleSessions() {
@@ -82,9 +99,13 @@ struct EdgeServer::Impl {
 };
 
 EdgeServer::EdgeServer(const std::string& listen_address,
-                       std::shared_ptr<EdgeSessionFactory> factory, EdgeServerLimits limits) {
+                       std::shared_ptr<EdgeSessionFactory> factory, EdgeServerLimits limits,
+                       EdgeServerSecurity security) {
   if (factory == nullptr) throw std::invalid_argument("edge server: no session factory given");
-  impl_ = std::make_unique<Impl>(listen_address, std::move(factory), limits);
+  if (security.tls() == security.tls_private_key_pem.empty()) {
+    throw std::invalid_argument("edge server: TLS needs both a certificate and its private key");
+  }
+  impl_ = std::make_unique<Impl>(listen_address, std::move(factory), limits, std::move(security));
 }
 
 EdgeServer::~EdgeServer() {

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "map/map_records.h"
+#include "net/server_security.h"
 #include "net/slice_sink.h"
 #include "net/wire_types.h"
 
@@ -24,6 +25,9 @@ class EdgeSessionBackend {
   // A new keyframe, in increasing upload sequence (gaps are uploads the client dropped; retries
   // of an upload already passed on are filtered out). Descriptors the client left out (keypoints
   // of points the edge has) are zero rows flagged in keyframe.features.descriptor_omitted.
+  // Throwing std::invalid_argument rejects the client's input (INVALID_ARGUMENT: an image that
+  // does not decode, say); anything else is the edge's failure (INTERNAL). The same for onFrame.
+  // Images reach the backend checked against the camera from their headers (received_image_check).
   virtual void onKeyFrame(KeyFrameUpload upload) = 0;
   // A whole frame in offload mode. nullopt: this backend does not track frames (the client gets
   // UNIMPLEMENTED).
@@ -52,6 +56,13 @@ struct EdgeServerLimits {
   std::size_t max_kept_slices = 256;               // per session, unacknowledged
   std::size_t max_kept_slice_bytes = 64u << 20;    // per session
   std::size_t max_probe_reply_bytes = 4u << 20;
+  // Per client (per token; without tokens every client is one): open sessions at most.
+  std::size_t max_sessions_per_client = 8;
+  // When every session slot is taken, the session idle longest (no RPC and no slice stream for
+  // at least this long) is closed to make room: unused sessions cannot lock others out.
+  std::chrono::milliseconds reclaim_idle_after{5000};
+  // Per session: keyframe uploads and offloaded frames per second (with a burst of as many).
+  double max_uploads_per_second = 200.0;
 };
 
 struct SessionStats {
@@ -74,8 +85,9 @@ class EdgeServer {
  public:
   // Listens at e.g. "0.0.0.0:50051" or "127.0.0.1:0" (any free port: see port()). Throws
   // std::runtime_error when the address cannot be bound.
+  // `security`: TLS and client tokens (server_security.h); by default plaintext and open.
   EdgeServer(const std::string& listen_address, std::shared_ptr<EdgeSessionFactory> factory,
-             EdgeServerLimits limits = {});
+             EdgeServerLimits limits = {}, EdgeServerSecurity security = {});
   ~EdgeServer();  // shutdown()
   EdgeServer(const EdgeServer&) = delete;
   EdgeServer& operator=(const EdgeServer&) = delete;

@@ -5,6 +5,7 @@
 
 #include <chrono>
 
+#include "net/received_image_check.h"
 #include "net/wire_convert.h"
 
 namespace edgeslam {
@@ -57,12 +58,46 @@ struct CallAccounting {
 }  // namespace
 
 EdgeService::EdgeService(SessionRegistry& registry, std::shared_ptr<EdgeSessionFactory> factory,
-                         const EdgeServerLimits& limits)
-    : registry_(registry), factory_(std::move(factory)), limits_(limits) {}
+                         const EdgeServerLimits& limits, std::shared_ptr<const AccessTokens> tokens)
+    : registry_(registry),
+      factory_(std::move(factory)),
+      limits_(limits),
+      tokens_(std::move(tokens)) {}
 
-grpc::Status EdgeService::findSession(const v1::RequestHeader& header,
+grpc::Status EdgeService::authenticate(const grpc::ServerContext& context,
+                                       const AccessGrant** grant) const {
+  *grant = nullptr;
+  if (tokens_ == nullptr) return grpc::Status::OK;
+  const auto& metadata = context.client_metadata();
+  const auto found = metadata.find(kAuthorizationMetadataKey);
+  if (found == metadata.end()) {
+    return {grpc::StatusCode::UNAUTHENTICATED,
+            "this edge server wants a client token (authorization: Bearer TOKEN; edgeslam "
+            "client --token or EDGESLAM_TOKEN)"};
+  }
+  const std::string_view value(found->second.data(), found->second.size());
+  *grant = tokens_->find(bearerToken(value));
+  if (*grant == nullptr) {
+    return {grpc::StatusCode::UNAUTHENTICATED, "the client token is not known to this edge server"};
+  }
+  return grpc::Status::OK;
+}
+
+grpc::Status EdgeService::admitUpload(ServerSession& session) const {
+  if (session.upload_rate.admit(limits_.max_uploads_per_second, std::chrono::steady_clock::now())) {
+    return grpc::Status::OK;
+  }
+  return {grpc::StatusCode::RESOURCE_EXHAUSTED,
+          fmt::format("session {:#x} sends more than {:g} uploads and frames a second",
+                      session.config.session_id, limits_.max_uploads_per_second)};
+}
+
+grpc::Status EdgeService::findSession(const grpc::ServerContext& context,
+                                      const v1::RequestHeader& header,
                                       std::shared_ptr<ServerSession>* session) const {
   if (grpc::Status status = checkVersion(header); !status.ok()) return status;
+  const AccessGrant* grant = nullptr;
+  if (grpc::Status status = authenticate(context, &grant); !status.ok()) return status;
   if (stopping_.load()) return {grpc::StatusCode::UNAVAILABLE, "the edge server is shutting down"};
   *session = registry_.find(header.session_id());
   if (*session == nullptr) {
@@ -71,14 +106,32 @@ grpc::Status EdgeService::findSession(const v1::RequestHeader& header,
                         "the server restarted): open a new session",
                         header.session_id())};
   }
+  if (grant != nullptr && (*session)->owner != grant->label) {
+    session->reset();
+    return {grpc::StatusCode::PERMISSION_DENIED,
+            fmt::format("session {:#x} belongs to another client", header.session_id())};
+  }
   return grpc::Status::OK;
 }
 
-grpc::Status EdgeService::OpenSession(grpc::ServerContext* /*context*/,
+grpc::Status EdgeService::OpenSession(grpc::ServerContext* context,
                                       const v1::OpenSessionRequest* request,
                                       v1::OpenSessionReply* reply) {
   if (grpc::Status status = checkVersion(request->header()); !status.ok()) return status;
+  const AccessGrant* grant = nullptr;
+  if (grpc::Status status = authenticate(*context, &grant); !status.ok()) return status;
   if (stopping_.load()) return {grpc::StatusCode::UNAVAILABLE, "the edge server is shutting down"};
+  std::string map = kDefaultMapName;
+  if (const auto found = context->client_metadata().find(kMapMetadataKey);
+      found != context->client_metadata().end()) {
+    map.assign(found->second.data(), found->second.size());
+  }
+  if (grant != nullptr && !grant->permitsMap(map)) {
+    return {grpc::StatusCode::PERMISSION_DENIED,
+            fmt::format("this client token does not give access to map '{}'", map)};
+  }
+  SessionOwner owner;
+  if (grant != nullptr) owner = {grant->label, limits_.max_sessions_per_client};
   SessionConfig config;
   try {
     config = fromProto(*request);
@@ -87,7 +140,7 @@ grpc::Status EdgeService::OpenSession(grpc::ServerContext* /*context*/,
   }
   std::shared_ptr<ServerSession> session;
   try {
-    session = registry_.open(std::move(config), *factory_);
+    session = registry_.open(std::move(config), *factory_, owner);
   } catch (const SessionRegistryFull& e) {
     return {grpc::StatusCode::RESOURCE_EXHAUSTED, e.what()};
   } catch (const std::invalid_argument& e) {
@@ -108,11 +161,13 @@ grpc::Status EdgeService::OpenSession(grpc::ServerContext* /*context*/,
   return grpc::Status::OK;
 }
 
-grpc::Status EdgeService::CloseSession(grpc::ServerContext* /*context*/,
+grpc::Status EdgeService::CloseSession(grpc::ServerContext* context,
                                        const v1::CloseSessionRequest* request,
                                        v1::CloseSessionReply* reply) {
   std::shared_ptr<ServerSession> session;
-  if (grpc::Status status = findSession(request->header(), &session); !status.ok()) return status;
+  if (grpc::Status status = findSession(*context, request->header(), &session); !status.ok()) {
+    return status;
+  }
   session->uplink_bytes += request->ByteSizeLong();
   reply->set_uplink_bytes(session->uplink_bytes.load());
   reply->set_downlink_bytes(session->downlink_bytes.load() + reply->ByteSizeLong());
@@ -121,16 +176,19 @@ grpc::Status EdgeService::CloseSession(grpc::ServerContext* /*context*/,
   return grpc::Status::OK;
 }
 
-grpc::Status EdgeService::UploadKeyFrame(grpc::ServerContext* /*context*/,
+grpc::Status EdgeService::UploadKeyFrame(grpc::ServerContext* context,
                                          const v1::UploadKeyFrameRequest* request,
                                          v1::UploadKeyFrameReply* reply) {
   std::shared_ptr<ServerSession> session;
-  if (grpc::Status status = findSession(request->header(), &session); !status.ok()) return status;
+  if (grpc::Status status = findSession(*context, request->header(), &session); !status.ok()) {
+    return status;
+  }
   CallAccounting accounting(session.get(), *request, *reply);
   KeyFrameUpload upload;
   try {
     if (!request->has_upload()) throw WireError("the request carries no upload");
     upload = fromProto(request->upload());
+    checkKeyFrameImage(upload, session->config.camera);
   } catch (const WireError& e) {
     return invalid(e);
   }
@@ -143,9 +201,12 @@ grpc::Status EdgeService::UploadKeyFrame(grpc::ServerContext* /*context*/,
     reply->set_duplicate(true);
     return grpc::Status::OK;
   }
+  if (grpc::Status status = admitUpload(*session); !status.ok()) return status;
   session->last_upload_sequence = sequence;
   try {
     session->backend->onKeyFrame(std::move(upload));
+  } catch (const std::invalid_argument& e) {
+    return invalid(e);  // the upload passed the wire checks but the backend cannot use it
   } catch (const std::exception& e) {
     return internal("keyframe upload", e);
   }
@@ -157,7 +218,9 @@ grpc::Status EdgeService::StreamSlices(grpc::ServerContext* context,
                                        const v1::StreamSlicesRequest* request,
                                        grpc::ServerWriter<v1::MapSlice>* writer) {
   std::shared_ptr<ServerSession> session;
-  if (grpc::Status status = findSession(request->header(), &session); !status.ok()) return status;
+  if (grpc::Status status = findSession(*context, request->header(), &session); !status.ok()) {
+    return status;
+  }
   session->uplink_bytes += request->ByteSizeLong();
   ++session->active_streams;
   struct StreamEnd {
@@ -221,9 +284,11 @@ grpc::Status EdgeService::StreamSlices(grpc::ServerContext* context,
   }
 }
 
-grpc::Status EdgeService::Probe(grpc::ServerContext* /*context*/, const v1::ProbeRequest* request,
+grpc::Status EdgeService::Probe(grpc::ServerContext* context, const v1::ProbeRequest* request,
                                 v1::ProbeReply* reply) {
   if (grpc::Status status = checkVersion(request->header()); !status.ok()) return status;
+  const AccessGrant* grant = nullptr;
+  if (grpc::Status status = authenticate(*context, &grant); !status.ok()) return status;
   if (request->reply_bytes() > limits_.max_probe_reply_bytes) {
     return {grpc::StatusCode::INVALID_ARGUMENT,
             fmt::format("probe reply of {} bytes asked; at most {}", request->reply_bytes(),
@@ -231,6 +296,7 @@ grpc::Status EdgeService::Probe(grpc::ServerContext* /*context*/, const v1::Prob
   }
   std::shared_ptr<ServerSession> session;
   if (request->header().session_id() != 0) session = registry_.find(request->header().session_id());
+  if (session != nullptr && grant != nullptr && session->owner != grant->label) session.reset();
   CallAccounting accounting(session.get(), *request, *reply);
   // Incompressible filler, so a compressing link cannot shortcut the measurement.
   std::string* payload = reply->mutable_payload();
@@ -244,15 +310,18 @@ grpc::Status EdgeService::Probe(grpc::ServerContext* /*context*/, const v1::Prob
   return grpc::Status::OK;
 }
 
-grpc::Status EdgeService::OffloadFrame(grpc::ServerContext* /*context*/,
+grpc::Status EdgeService::OffloadFrame(grpc::ServerContext* context,
                                        const v1::OffloadFrameRequest* request,
                                        v1::OffloadFrameReply* reply) {
   std::shared_ptr<ServerSession> session;
-  if (grpc::Status status = findSession(request->header(), &session); !status.ok()) return status;
+  if (grpc::Status status = findSession(*context, request->header(), &session); !status.ok()) {
+    return status;
+  }
   CallAccounting accounting(session.get(), *request, *reply);
   edgeslam::OffloadFrame frame;
   try {
     frame = fromProto(*request);
+    checkOffloadedImages(frame, session->config.camera);
   } catch (const WireError& e) {
     return invalid(e);
   }
@@ -260,8 +329,11 @@ grpc::Status EdgeService::OffloadFrame(grpc::ServerContext* /*context*/,
   const auto start = std::chrono::steady_clock::now();
   {
     std::lock_guard lock(session->backend_mutex);
+    if (grpc::Status status = admitUpload(*session); !status.ok()) return status;
     try {
       result = session->backend->onFrame(std::move(frame));
+    } catch (const std::invalid_argument& e) {
+      return invalid(e);
     } catch (const std::exception& e) {
       return internal("frame offload", e);
     }

@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "edgeslam/v1/edgeslam.grpc.pb.h"
+#include "net/access_tokens.h"
 #include "net/edge_server.h"
 #include "net/session_registry.h"
 
@@ -12,8 +13,9 @@ namespace edgeslam {
 
 class EdgeService final : public v1::EdgeSlam::Service {
  public:
+  // `tokens` null: every client is let in without authorization metadata.
   EdgeService(SessionRegistry& registry, std::shared_ptr<EdgeSessionFactory> factory,
-              const EdgeServerLimits& limits);
+              const EdgeServerLimits& limits, std::shared_ptr<const AccessTokens> tokens = nullptr);
 
   // Makes every stream return at its next poll and refuses new calls.
   void stop() { stopping_.store(true); }
@@ -33,12 +35,19 @@ class EdgeService final : public v1::EdgeSlam::Service {
                             v1::OffloadFrameReply* reply) override;
 
  private:
-  grpc::Status findSession(const v1::RequestHeader& header,
+  // The caller's grant from its `authorization: Bearer TOKEN` metadata (nullptr without
+  // tokens); UNAUTHENTICATED when it has none or an unknown one.
+  grpc::Status authenticate(const grpc::ServerContext& context, const AccessGrant** grant) const;
+  // The header's session, when it exists and belongs to the caller.
+  grpc::Status findSession(const grpc::ServerContext& context, const v1::RequestHeader& header,
                            std::shared_ptr<ServerSession>* session) const;
+  // RESOURCE_EXHAUSTED when the session sends uploads or frames faster than its limit.
+  grpc::Status admitUpload(ServerSession& session) const;
 
   SessionRegistry& registry_;
   std::shared_ptr<EdgeSessionFactory> factory_;
   const EdgeServerLimits limits_;
+  const std::shared_ptr<const AccessTokens> tokens_;
   std::atomic<bool> stopping_{false};
 };
 

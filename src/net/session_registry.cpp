@@ -1,13 +1,63 @@
 #include "net/session_registry.h"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include <algorithm>
 
 namespace edgeslam {
 
-SessionRegistry::SessionRegistry(std::size_t max_sessions, SliceQueueLimits slice_limits)
-    : max_sessions_(std::clamp<std::size_t>(max_sessions, 1, 255)), slice_limits_(slice_limits) {}
+bool UploadRate::admit(double per_second, std::chrono::steady_clock::time_point now) {
+  if (per_second <= 0.0) return true;
+  if (tokens < 0.0) {
+    tokens = per_second;
+  } else {
+    const double elapsed_s = std::chrono::duration<double>(now - last).count();
+    tokens = std::min(per_second, tokens + std::max(0.0, elapsed_s) * per_second);
+  }
+  last = now;
+  if (tokens < 1.0) return false;
+  tokens -= 1.0;
+  return true;
+}
+
+SessionRegistry::SessionRegistry(std::size_t max_sessions, SliceQueueLimits slice_limits,
+                                 std::chrono::milliseconds reclaim_idle_after)
+    : max_sessions_(std::clamp<std::size_t>(max_sessions, 1, 255)),
+      slice_limits_(slice_limits),
+      reclaim_idle_after_(reclaim_idle_after) {}
+
+std::uint64_t SessionRegistry::reclaimableLocked() const {
+  if (reclaim_idle_after_.count() <= 0) return 0;
+  const std::int64_t now = std::chrono::steady_clock::now().time_since_epoch().count();
+  std::int64_t longest = std::chrono::nanoseconds(reclaim_idle_after_).count();
+  std::uint64_t victim = 0;
+  for (const auto& [id, session] : sessions_) {
+    const std::int64_t idle = now - session->last_activity_ns.load();
+    if (session->active_streams.load() == 0 && idle >= longest) {
+      longest = idle;
+      victim = id;
+    }
+  }
+  return victim;
+}
+
+std::shared_ptr<ServerSession> SessionRegistry::removeLocked(std::uint64_t session_id) {
+  const auto it = sessions_.find(session_id);
+  if (it == sessions_.end()) return nullptr;
+  std::shared_ptr<ServerSession> session = std::move(it->second);
+  sessions_.erase(it);
+  origin_in_use_[session->config.id_origin] = false;
+  --reserved_;
+  releaseOwnerLocked(session->owner);
+  return session;
+}
+
+void SessionRegistry::releaseOwnerLocked(const std::string& owner) {
+  const auto it = owner_sessions_.find(owner);
+  if (it == owner_sessions_.end()) return;
+  if (--it->second == 0) owner_sessions_.erase(it);
+}
 
 std::uint8_t SessionRegistry::reserveOriginLocked(std::uint8_t preferred) {
   if (reserved_ >= max_sessions_) {
@@ -31,15 +81,38 @@ std::uint8_t SessionRegistry::reserveOriginLocked(std::uint8_t preferred) {
 }
 
 std::shared_ptr<ServerSession> SessionRegistry::open(SessionConfig config,
-                                                     EdgeSessionFactory& factory) {
+                                                     EdgeSessionFactory& factory,
+                                                     const SessionOwner& owner) {
+  std::shared_ptr<ServerSession> reclaimed;
   {
     std::lock_guard lock(mutex_);
+    const auto owned = owner_sessions_.find(owner.name);
+    if (owner.max_sessions > 0 && owned != owner_sessions_.end() &&
+        owned->second >= owner.max_sessions) {
+      throw SessionRegistryFull(fmt::format("{} already holds its maximum of {} sessions",
+                                            owner.name, owner.max_sessions));
+    }
+    if (reserved_ >= max_sessions_) {
+      if (const std::uint64_t victim = reclaimableLocked(); victim != 0) {
+        reclaimed = removeLocked(victim);
+        ++reclaimed_;
+      }
+    }
     config.id_origin = reserveOriginLocked(config.id_origin);
+    ++owner_sessions_[owner.name];
     do {
       config.session_id = random_();
     } while (config.session_id == 0 || sessions_.count(config.session_id) != 0);
   }
+  if (reclaimed) {
+    spdlog::info("edge server: session {:#x} ('{}') closed, unused for {} ms, to make room",
+                 reclaimed->config.session_id, reclaimed->config.client_name,
+                 reclaim_idle_after_.count());
+    reclaimed->slices.close();
+    reclaimed.reset();
+  }
   auto session = std::make_shared<ServerSession>(std::move(config), slice_limits_);
+  session->owner = owner.name;
   try {
     session->backend = factory.open(session->config, session->slices);
     if (!session->backend) throw std::runtime_error("the session factory returned no backend");
@@ -47,6 +120,7 @@ std::shared_ptr<ServerSession> SessionRegistry::open(SessionConfig config,
     std::lock_guard lock(mutex_);
     origin_in_use_[session->config.id_origin] = false;
     --reserved_;
+    releaseOwnerLocked(session->owner);
     throw;
   }
   session->touch();
@@ -65,12 +139,8 @@ bool SessionRegistry::close(std::uint64_t session_id, bool idle) {
   std::shared_ptr<ServerSession> session;
   {
     std::lock_guard lock(mutex_);
-    const auto it = sessions_.find(session_id);
-    if (it == sessions_.end()) return false;
-    session = std::move(it->second);
-    sessions_.erase(it);
-    origin_in_use_[session->config.id_origin] = false;
-    --reserved_;
+    session = removeLocked(session_id);
+    if (session == nullptr) return false;
     if (idle) ++idle_closed_;  // counted before the backend can go, for whoever watches it go
   }
   session->slices.close();

@@ -167,7 +167,7 @@ TEST_F(EdgeLoopback, TwoSessionsGetDistinctOrigins) {
 
 TEST_F(EdgeLoopback, OffloadFrameReturnsThePose) {
   EdgeClient client(server->address(), test::sampleSessionConfig(), clientOptions());
-  const auto result = client.offloadFrame({41, 1.5, "jpeg", {1, 2, 3}, "", {}});
+  const auto result = client.offloadFrame({41, 1.5, "jpeg", test::sampleFrameImage(), "", {}});
   ASSERT_TRUE(result.has_value());
   EXPECT_EQ(result->frame_index, 41u);
   EXPECT_EQ(result->state, OffloadTrackingState::kOk);
@@ -182,7 +182,7 @@ TEST(EdgeServerOffload, BackendWithoutOffloadAnswersUnimplemented) {
   options.connect_timeout = 10s;
   EdgeClient client(server.address(), test::sampleSessionConfig(), options);
   try {
-    client.offloadFrame({1, 0.0, "png", {1}, "", {}});
+    client.offloadFrame({1, 0.0, "jpeg", test::sampleFrameImage(), "", {}});
     ADD_FAILURE() << "no error";
   } catch (const EdgeClientError& e) {
     EXPECT_THAT(e.what(), HasSubstr("do not track whole frames"));
@@ -241,8 +241,9 @@ TEST_F(EdgeLoopback, OversizedMessageIsResourceExhaustedAndTheServerGoesOn) {
   const grpc::Status status = rawUpload(*stub, request);
   EXPECT_EQ(status.error_code(), grpc::StatusCode::RESOURCE_EXHAUSTED) << status.error_message();
 
-  upload.image_bytes.resize(1000);
-  request.mutable_upload()->set_image(std::string(1000, 'x'));
+  upload.image_bytes = test::sampleKeyFrameImage(1000);
+  request.mutable_upload()->set_image(
+      std::string(upload.image_bytes.begin(), upload.image_bytes.end()));
   const grpc::Status next = rawUpload(*stub, request);
   EXPECT_TRUE(next.ok()) << next.error_message();
   auto log = factory->session(0);

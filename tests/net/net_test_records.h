@@ -1,6 +1,8 @@
 #pragma once
 // Sample wire records for the net tests: every field set to something non-default, so a field
 // lost in either direction of a conversion shows.
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
 
@@ -74,6 +76,24 @@ inline MapPointRecord samplePoint(std::uint64_t id, std::mt19937& rng) {
   return p;
 }
 
+// The header of a 320 x 240 grey JPEG (the sample camera halved), padded with zeros to `size`:
+// what the edge server reads before it accepts a keyframe image.
+inline std::vector<std::uint8_t> sampleKeyFrameImage(std::size_t size = 0) {
+  constexpr std::array<std::uint8_t, 17> kHeader{0xff, 0xd8, 0xff, 0xc0, 0x00, 0x0b,
+                                                 8,    0x00, 0xf0, 0x01, 0x40, 0x01,
+                                                 0x01, 0x11, 0x00, 0xff, 0xd9};
+  std::vector<std::uint8_t> bytes(std::max(size, kHeader.size()), 0);
+  std::copy(kHeader.begin(), kHeader.end(), bytes.begin());
+  return bytes;
+}
+
+// The header of a 640 x 480 grey JPEG: an offloaded frame of the sample camera, as far as the
+// edge server's checks read it.
+inline std::vector<std::uint8_t> sampleFrameImage() {
+  return {0xff, 0xd8, 0xff, 0xc0, 0x00, 0x0b, 8,    0x01, 0xe0,
+          0x02, 0x80, 0x01, 0x01, 0x11, 0x00, 0xff, 0xd9};
+}
+
 inline KeyFrameUpload sampleUpload(std::uint64_t sequence, int keypoints, int new_points,
                                    std::mt19937& rng) {
   KeyFrameUpload u;
@@ -82,7 +102,7 @@ inline KeyFrameUpload sampleUpload(std::uint64_t sequence, int keypoints, int ne
   for (int i = 0; i < new_points; ++i)
     u.new_points.push_back(samplePoint(clientId(3, 50000 + i), rng));
   u.image_encoding = "jpeg";
-  u.image_bytes = {0xff, 0xd8, 0xff, 0xe0, 1, 2, 3};
+  u.image_bytes = sampleKeyFrameImage();
   u.acknowledged_slice = sequence > 1 ? sequence - 1 : 0;
   u.segmenter_nms = 0.7f;
   return u;
