@@ -241,7 +241,8 @@ int runPipeline(const RunOptions& options) {
       makeSlamSystem(options, mode, reader->camera(), sensor, slam_options, edge);
   SlamSystem& slam = *slam_system;
   const auto viewer_attachment = viewer ? viewer->attach(slam) : nullptr;
-  viz::RunStatus view_status{.frames_total = frame_count, .mode = mode, .sensor = sensor_name};
+  viz::RunStatus view_status{
+      .frames_total = frame_count, .mode = mode, .sensor = sensor_name, .link = options.link};
   // e2e: from the frame's arrival to its pose. With --realtime a frame arrives at its due time
   // (so a client that falls behind makes later frames wait); otherwise when it has been read.
   SampleStats client_ms, load_ms, e2e_ms;
@@ -313,12 +314,18 @@ int runPipeline(const RunOptions& options) {
       view_status.keyframes = keyframes;
       view_status.map_points = map_points;
       view_status.client_ms = processing_ms;
+      view_status.e2e_ms = frame_e2e_ms;
+      if (const auto* edge_slam = dynamic_cast<const EdgeSlam*>(&slam);
+          edge_slam != nullptr && edge_slam->adaptation() != nullptr) {
+        view_status.adaptation_row = static_cast<int>(edge_slam->adaptation()->row());
+      }
       const LinkTraffic traffic = slam.linkTraffic();
       view_status.uplink_bytes = traffic.uplink_bytes;
       view_status.downlink_bytes = traffic.downlink_bytes;
       const std::optional<SE3d> camera =
           result.T_cw ? std::optional<SE3d>(result.T_cw->inverse()) : std::nullopt;
       viewer->view().publishFrame(view_status, camera, frame.ground_truth);
+      viewer->publishImage(frame.color.empty() ? frame.gray : frame.color, slam.lastSemanticFrame());
     }
   }
   progress.finish();

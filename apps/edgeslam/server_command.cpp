@@ -11,6 +11,7 @@
 #include "commands.h"
 #include "pipeline/slam_session_backend.h"
 #include "segmenter_option.h"
+#include "server_viewer.h"
 #include "vocabulary_option.h"
 
 namespace edgeslam::cli {
@@ -29,9 +30,13 @@ struct ServerOptions {
   std::string semantic = "auto";
   std::filesystem::path models_dir;
   int segment_input = 256;
+  std::optional<int> viewer_port;
+  std::string viewer_host = "127.0.0.1";
 };
 
 int runServer(const ServerOptions& o) {
+  std::unique_ptr<ServerViewer> viewer;
+  if (o.viewer_port) viewer = std::make_unique<ServerViewer>(o.viewer_host, *o.viewer_port);
   SlamSessionOptions options;
   options.mapping.vocabulary = loadVocabulary(o.vocabulary);
   if (o.semantic != "off") {
@@ -49,7 +54,10 @@ int runServer(const ServerOptions& o) {
   }
   const std::string& listen = o.listen;
   const int status_interval_s = o.status_interval_s;
-  EdgeServer server(listen, std::make_shared<SlamSessionFactory>(options));
+  std::shared_ptr<EdgeSessionFactory> factory = std::make_shared<SlamSessionFactory>(options);
+  if (viewer) factory = viewer->wrap(std::move(factory));
+  EdgeServer server(listen, std::move(factory));
+  const auto viewer_attachment = viewer ? viewer->attach(server) : nullptr;
   spdlog::info("edge server listening on {} (Ctrl-C to stop)", server.address());
   std::signal(SIGINT, requestStop);
   std::signal(SIGTERM, requestStop);
@@ -88,6 +96,12 @@ void addServerCommand(CLI::App& app) {
       ->capture_default_str();
   cmd->add_option("--models", o->models_dir,
                   "Segmentation models folder (default: the shared models)");
+  cmd->add_option("--viewer", o->viewer_port,
+                  "Serve the edge view (every session's map and figures) on this port (0 = any "
+                  "free port; the URL is logged)")
+      ->check(CLI::Range(0, 65535));
+  cmd->add_option("--viewer-host", o->viewer_host,
+                  "Address the viewer listens on (0.0.0.0 = every interface)");
   cmd->callback([o] { exitCode() = runServer(*o); });
 }
 
