@@ -42,7 +42,8 @@ std::unique_ptr<RunViewer::Attachment> RunViewer::attach(const SlamSystem& slam)
 void RunViewer::publishImage(const cv::Mat& image, const SemanticFrame* semantic) {
   viz::FrameImageSlot& images = *view_.images();
   if (!images.wanted() || image.empty()) return;
-  viz::FrameImage frame{.image = image.clone()};
+  viz::FrameImage frame;
+  frame.image = image.clone();
   if (semantic != nullptr && semantic->kept) {
     std::set<std::pair<float, float>> kept;
     for (const cv::KeyPoint& k : semantic->kept->keypoints) {
