@@ -31,7 +31,7 @@ if (!args.dataset || !existsSync(args.dataset)) {
   console.log(`SKIPPED: dataset ${args.dataset} not found`);
   process.exit(SKIP);
 }
-const puppeteer = createRequire(path.join(args.modules, 'index.js'))('puppeteer-core');
+const puppeteer = createRequire(path.resolve(args.modules, 'index.js'))('puppeteer-core');
 
 const children = new Set();
 const outDir = mkdtempSync(path.join(tmpdir(), 'edgeslam-browser-'));

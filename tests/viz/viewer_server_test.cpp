@@ -1,6 +1,8 @@
 // The viewer's HTTP server on a free loopback port, talked to with httplib's client.
 #include "viz/viewer_server.h"
 
+#include "viz/live_view.h"
+
 #include <gtest/gtest.h>
 #include <httplib.h>
 
