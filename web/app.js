@@ -16,7 +16,13 @@ const COLORS = {
 };
 // One colour per edge session, by session id.
 const CLIENT_COLORS = [0x5ad17a, 0x5a9cff, 0xf0a53c, 0xd36bff, 0x3fd0d4, 0xff7a9c, 0xc8d14a];
-const clientColor = (id) => CLIENT_COLORS[id % CLIENT_COLORS.length];
+// Sessions keep the colour of the order they were first seen in.
+const sessionColorIndex = new Map();
+const clientNumber = (id) => {
+  if (!sessionColorIndex.has(id)) sessionColorIndex.set(id, sessionColorIndex.size);
+  return sessionColorIndex.get(id) + 1;
+};
+const clientColor = (id) => CLIENT_COLORS[(clientNumber(id) - 1) % CLIENT_COLORS.length];
 const css = (hex) => '#' + hex.toString(16).padStart(6, '0');
 
 // What the browser test reads (tests/browser/viewer_test.mjs).
@@ -213,7 +219,7 @@ function setLegend(items) {
 const CHART_POINTS = 600;
 let chart = null;
 let chartData = null;
-function makeChart(title, series) {
+function makeChart(title, series, xLabel = 'frame') {
   const el = document.getElementById('chart');
   el.innerHTML = '';
   chartData = [[], ...series.map(() => [])];
@@ -222,7 +228,7 @@ function makeChart(title, series) {
     scales: { x: { time: false } },
     axes: [{ stroke: '#8b95a3', grid: { stroke: '#232931' } },
       { stroke: '#8b95a3', grid: { stroke: '#232931' }, size: 40 }],
-    series: [{ label: 'frame' }, ...series.map(([label, color]) => ({ label, stroke: css(color), width: 1.5 }))],
+    series: [{ label: xLabel }, ...series.map(([label, color]) => ({ label, stroke: css(color), width: 1.5 }))],
   }, chartData, el);
 }
 
@@ -312,7 +318,7 @@ function showEdge(snapshot, first) {
     document.getElementById('view-name').textContent = '\u00b7 edge';
     document.getElementById('session-picker').hidden = false;
     document.getElementById('events').hidden = false;
-    makeChart('keyframes per client', CLIENT_COLORS.slice(0, 4).map((c, i) => [`client ${i + 1}`, c]));
+    makeChart('keyframes per client', CLIENT_COLORS.slice(0, 4).map((c, i) => [`client ${i + 1}`, c]), 'update');
     setLegend([[COLORS.keyframe, 'keyframes'], [COLORS.camera, 'live position'], [COLORS.point, 'map points']]);
     setFollow(false);
   }
@@ -323,7 +329,7 @@ function showEdge(snapshot, first) {
     sessionSelect.innerHTML = '';
     for (const value of options) {
       const s = sessions.find((x) => String(x.session_id) === value);
-      sessionSelect.add(new Option(s ? `session ${value} \u00b7 ${s.client_name}` : 'all maps', value));
+      sessionSelect.add(new Option(s ? `client ${clientNumber(value)} \u00b7 ${s.client_name}` : 'all maps', value));
     }
     if (!options.includes(chosenSession)) chosenSession = 'all';
     sessionSelect.value = chosenSession;
@@ -333,7 +339,7 @@ function showEdge(snapshot, first) {
   const rows = [['sessions', `${sessions.length} (${snapshot.status.sessions_opened} opened)`],
     ['loop closures', snapshot.status.loops]];
   for (const s of sessions) {
-    rows.push([`\u25cf session ${s.session_id} \u00b7 ${s.client_name}`]);
+    rows.push([`\u25cf client ${clientNumber(s.session_id)} \u00b7 ${s.client_name} (${s.sensor})`]);
     rows.push(['keyframes / points', `${s.keyframe_count} / ${s.map_points}`]);
     rows.push(['loops closed', s.loops]);
     rows.push(['bytes up / down', `${formatBytes(s.uplink_bytes)} / ${formatBytes(s.downlink_bytes)}`]);
@@ -345,7 +351,10 @@ function showEdge(snapshot, first) {
   for (const tr of statsTable.rows) {
     if (tr.className === 'client') tr.cells[0].style.color = css(clientColor(sessions[heading++].session_id));
   }
-  addChartSample(snapshot.version, CLIENT_COLORS.slice(0, 4).map((_, i) => sessions[i]?.keyframe_count ?? null));
+  // Client k of the chart is the k-th session seen (its colour).
+  const byOrder = [];
+  for (const s of sessions) byOrder[[...sessionColorIndex.keys()].indexOf(s.session_id)] = s.keyframe_count;
+  addChartSample(snapshot.version, [0, 1, 2, 3].map((i) => byOrder[i] ?? null));
 
   const events = document.getElementById('events');
   events.innerHTML = '';

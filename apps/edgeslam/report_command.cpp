@@ -188,15 +188,18 @@ details { margin-top: 12px; } summary { cursor: pointer; color: #1f7ae0; }
 
 int writeReport(const ReportOptions& o) {
   const fs::path dir = o.run_dir;
-  if (!fs::is_directory(dir)) throw std::runtime_error(fmt::format("no run folder {}", dir.string()));
+  if (!fs::is_directory(dir))
+    throw std::runtime_error(fmt::format("no run folder {}", dir.string()));
   const fs::path trajectory_file = dir / "trajectory.tum";
   if (!fs::exists(trajectory_file)) {
-    throw std::runtime_error(fmt::format("{} has no trajectory.tum (write a run there with "
-                                         "`edgeslam run ... --out {}`)",
-                                         dir.string(), dir.string()));
+    throw std::runtime_error(
+        fmt::format("{} has no trajectory.tum (write a run there with "
+                    "`edgeslam run ... --out {}`)",
+                    dir.string(), dir.string()));
   }
   nlohmann::json metrics = nlohmann::json::object();
-  if (fs::exists(dir / "metrics.json")) metrics = nlohmann::json::parse(readFile(dir / "metrics.json"));
+  if (fs::exists(dir / "metrics.json"))
+    metrics = nlohmann::json::parse(readFile(dir / "metrics.json"));
   nlohmann::json data = nlohmann::json::object();
   const Trajectory estimate = readTumTrajectory(trajectory_file);
   const fs::path gt_file = o.ground_truth.empty() ? dir / "groundtruth.tum" : o.ground_truth;

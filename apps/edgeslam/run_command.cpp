@@ -334,7 +334,8 @@ int runPipeline(const RunOptions& options) {
       const std::optional<SE3d> camera =
           result.T_cw ? std::optional<SE3d>(result.T_cw->inverse()) : std::nullopt;
       viewer->view().publishFrame(view_status, camera, frame.ground_truth);
-      viewer->publishImage(frame.color.empty() ? frame.gray : frame.color, slam.lastSemanticFrame());
+      viewer->publishImage(frame.color.empty() ? frame.gray : frame.color,
+                           slam.lastSemanticFrame());
     }
   }
   progress.finish();
@@ -498,7 +499,8 @@ int runPipeline(const RunOptions& options) {
     writeTumTrajectory(options.out_dir / "trajectory_final.tum", final_traj);
     writeTumTrajectory(options.out_dir / "keyframes.tum", slam.keyframeTrajectory());
     // For `edgeslam report`: the dataset's poses at the frames the run read.
-    if (!ground_truth.empty()) writeTumTrajectory(options.out_dir / "groundtruth.tum", ground_truth);
+    if (!ground_truth.empty())
+      writeTumTrajectory(options.out_dir / "groundtruth.tum", ground_truth);
     writeFrameLog(options.out_dir / "frames.csv", frame_log);
     std::ofstream out(options.out_dir / "metrics.json");
     out << metrics.dump(2) << "\n";

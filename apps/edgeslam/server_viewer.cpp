@@ -16,7 +16,8 @@ ServerViewer::~ServerViewer() {
   server_->stop();
 }
 
-std::shared_ptr<EdgeSessionFactory> ServerViewer::wrap(std::shared_ptr<EdgeSessionFactory> factory) {
+std::shared_ptr<EdgeSessionFactory> ServerViewer::wrap(
+    std::shared_ptr<EdgeSessionFactory> factory) {
   return std::make_shared<viz::ViewedSessionFactory>(std::move(factory), directory_);
 }
 

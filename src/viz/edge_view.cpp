@@ -59,8 +59,8 @@ std::string EdgeView::buildJson() {
       MapSample sample = backend->mapSample(points_each);
       loops = backend->loops();
       const std::size_t n = sample.keyframe_poses.size();
-      const std::size_t step = std::max<std::size_t>(1, (n + options_.max_keyframes - 1) /
-                                                            options_.max_keyframes);
+      const std::size_t step =
+          std::max<std::size_t>(1, (n + options_.max_keyframes - 1) / options_.max_keyframes);
       for (std::size_t i = 0; i < n; ++i) {
         const SE3d& pose = sample.keyframe_poses[i];
         map.trajectory.push_back(pose.translation());
@@ -87,7 +87,8 @@ std::string EdgeView::buildJson() {
     }
     nlohmann::json encoded = toJson(map);
     nlohmann::json session = statsJson(session_stats);
-    session["session_id"] = entry.session_id;
+    // As text: session ids use all 64 bits, more than a JavaScript number holds exactly.
+    session["session_id"] = std::to_string(entry.session_id);
     session["client_name"] = entry.client_name;
     session["sensor"] = entry.sensor;
     session["keyframe_count"] = map.status.keyframes;
@@ -100,10 +101,10 @@ std::string EdgeView::buildJson() {
   }
   nlohmann::json events = nlohmann::json::array();
   for (const ViewerEvent& e : directory_->events()) {
-    events.push_back({{"time", fmt::format("{:%H:%M:%S}", fmt::gmtime(
-                                                              std::chrono::system_clock::to_time_t(
-                                                                  e.time)))},
-                      {"text", e.text}});
+    events.push_back(
+        {{"time",
+          fmt::format("{:%H:%M:%S}", fmt::gmtime(std::chrono::system_clock::to_time_t(e.time)))},
+         {"text", e.text}});
   }
   nlohmann::json snapshot = {{"view", "edge"},
                              {"status",

@@ -22,7 +22,7 @@
 namespace edgeslam::viz {
 
 struct EdgeViewOptions {
-  std::size_t max_points = 20000;  // over all sessions
+  std::size_t max_points = 20000;    // over all sessions
   std::size_t max_keyframes = 2000;  // per session
   std::chrono::milliseconds refresh{500};
 };

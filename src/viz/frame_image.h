@@ -8,10 +8,10 @@
 namespace edgeslam::viz {
 
 struct FrameImage {
-  cv::Mat image;                   // grey or BGR, the frame as the camera gave it
-  std::vector<cv::Point2f> kept;   // features tracking used
-  std::vector<cv::Point2f> culled; // features dropped as on a movable (dynamic) object
-  cv::Mat1b mask;                  // movable-object mask (non-zero), empty when there is none
+  cv::Mat image;                    // grey or BGR, the frame as the camera gave it
+  std::vector<cv::Point2f> kept;    // features tracking used
+  std::vector<cv::Point2f> culled;  // features dropped as on a movable (dynamic) object
+  cv::Mat1b mask;                   // movable-object mask (non-zero), empty when there is none
 };
 
 // Scaled down to at most `max_width` pixels wide; JPEG bytes.

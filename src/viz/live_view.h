@@ -17,8 +17,8 @@
 #include "pipeline/slam_system.h"
 #include "viz/frame_image_slot.h"
 #include "viz/trajectory_decimator.h"
-#include "viz/view_source.h"
 #include "viz/view_snapshot.h"
+#include "viz/view_source.h"
 
 namespace edgeslam::viz {
 

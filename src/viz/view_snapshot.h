@@ -29,7 +29,7 @@ struct RunStatus {
   std::string sensor;
   std::string link;         // the emulated link profile ("none" without one)
   int adaptation_row = -1;  // Table I row in use (0-based); -1 without self-adaptation
-  bool finished = false;  // the run is over (the viewer lingers on the final map)
+  bool finished = false;    // the run is over (the viewer lingers on the final map)
 };
 
 struct ViewPose {

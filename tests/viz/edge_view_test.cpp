@@ -22,7 +22,7 @@ TEST(EdgeView, ListsSessionsWithTheServersFiguresAndTheirComingsAndGoings) {
   auto snapshot = nlohmann::json::parse(view.snapshotJson());
   EXPECT_EQ(snapshot["view"], "edge");
   ASSERT_EQ(snapshot["sessions"].size(), 1u);
-  EXPECT_EQ(snapshot["sessions"][0]["session_id"], 7);
+  EXPECT_EQ(snapshot["sessions"][0]["session_id"], "7");
   EXPECT_EQ(snapshot["sessions"][0]["client_name"], "phone");
   EXPECT_EQ(snapshot["sessions"][0]["uplink_bytes"], 1234);
   EXPECT_TRUE(snapshot["sessions"][0]["camera"].is_null());  // no map yet

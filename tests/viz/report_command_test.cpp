@@ -43,7 +43,8 @@ TEST(ReportCommand, WritesOneSelfContainedPageForARun) {
   const auto start = html.find(marker);
   ASSERT_NE(start, std::string::npos);
   const auto end = html.find(";</script>", start);
-  const auto data = nlohmann::json::parse(html.substr(start + marker.size(), end - start - marker.size()));
+  const auto data =
+      nlohmann::json::parse(html.substr(start + marker.size(), end - start - marker.size()));
   // Trajectory against ground truth, the error over time, per-frame latency and bytes.
   ASSERT_TRUE(data.contains("top_view"));
   EXPECT_EQ(data["top_view"]["truth_x"].size(), data["top_view"]["estimate_x"].size());

@@ -1,8 +1,6 @@
 // The viewer's HTTP server on a free loopback port, talked to with httplib's client.
 #include "viz/viewer_server.h"
 
-#include "viz/live_view.h"
-
 #include <gtest/gtest.h>
 #include <httplib.h>
 
@@ -11,6 +9,8 @@
 #include <future>
 #include <nlohmann/json.hpp>
 #include <thread>
+
+#include "viz/live_view.h"
 
 namespace edgeslam::viz {
 namespace {
