@@ -133,6 +133,12 @@ function extentOf(flat) {
 let sceneSize = 1;
 let follow = true;
 let followTarget = null;
+// Drawn only when something changed (new data, the view moved): an idle page costs nothing, and a
+// software-rendered page (no GPU) leaves the CPU to tracking.
+let needsRender = true;
+function requestRender() {
+  needsRender = true;
+}
 
 function resize() {
   const w = container.clientWidth, h = container.clientHeight;
@@ -141,18 +147,26 @@ function resize() {
   renderer.domElement.style.height = h + 'px';
   camera3d.aspect = w / Math.max(1, h);
   camera3d.updateProjectionMatrix();
+  needsRender = true;
 }
 window.addEventListener('resize', resize);
 resize();
 
+controls.addEventListener('change', requestRender);
 function animate() {
   if (follow && followTarget) {
     const shift = followTarget.clone().sub(controls.target);
-    controls.target.add(shift);
-    camera3d.position.add(shift);
+    if (shift.lengthSq() > 0) {
+      controls.target.add(shift);
+      camera3d.position.add(shift);
+      needsRender = true;
+    }
   }
-  controls.update();
-  renderer.render(scene, camera3d);
+  if (controls.update()) needsRender = true;
+  if (needsRender) {
+    needsRender = false;
+    renderer.render(scene, camera3d);
+  }
   requestAnimationFrame(animate);
 }
 requestAnimationFrame(animate);
@@ -164,6 +178,7 @@ function fitView(flat) {
   camera3d.position.copy(center).add(new THREE.Vector3(0.6, 0.7, 0.9).multiplyScalar(size));
   camera3d.far = 100 * size;
   camera3d.updateProjectionMatrix();
+  requestRender();
 }
 
 // --- the panel --------------------------------------------------------------------------------
@@ -304,6 +319,7 @@ function showMobile(snapshot, first) {
   }
   if (first) fitView(snapshot.trajectory);
   progress.points = snapshot.points.length / 3;
+  requestRender();
 }
 
 // --- the edge view: every session the server holds ---------------------------------------------
@@ -384,6 +400,7 @@ function showEdge(snapshot, first) {
   }
   progress.points = points.length / 3;
   progress.sessions = sessions.length;
+  requestRender();
 }
 
 // --- the stream ----------------------------------------------------------------------------------
@@ -430,6 +447,7 @@ document.getElementById('follow').addEventListener('change', (e) => { follow = e
 document.getElementById('top-view').addEventListener('click', () => {
   const distance = camera3d.position.distanceTo(controls.target);
   camera3d.position.copy(controls.target).add(new THREE.Vector3(0, distance, 0.001));
+  requestRender();
 });
 document.getElementById('fit').addEventListener('click', () => {
   setFollow(false);
