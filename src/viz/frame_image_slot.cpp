@@ -28,7 +28,6 @@ void FrameImageSlot::publish(FrameImage frame) {
   std::lock_guard lock(mutex_);
   frame_ = std::move(frame);
   ++frame_version_;
-  ++published_;
 }
 
 std::optional<std::string> FrameImageSlot::jpeg() {

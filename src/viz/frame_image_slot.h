@@ -24,7 +24,6 @@ class FrameImageSlot {
 
   // Viewer: the latest image as JPEG (nullopt before the first); marks the image as wanted.
   std::optional<std::string> jpeg();
-  std::uint64_t published() const { return published_.load(); }
 
  private:
   static std::int64_t nowNs();
@@ -33,7 +32,6 @@ class FrameImageSlot {
   std::int64_t page_timeout_ns_;
   std::atomic<std::int64_t> last_request_ns_{0};
   std::atomic<std::int64_t> last_publish_ns_{0};
-  std::atomic<std::uint64_t> published_{0};
 
   std::mutex mutex_;
   FrameImage frame_;

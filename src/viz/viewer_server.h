@@ -1,6 +1,7 @@
 #pragma once
 // The web viewer's HTTP server (cpp-httplib, on threads of its own):
 //   GET /             the page          GET /app.js, /style.css  its script and style
+//   GET /lib/...      the libraries the page loads (three.js, uPlot; see web_assets.h)
 //   GET /api/state    the latest snapshot as JSON (view_snapshot.h)
 //   GET /api/events   Server-Sent Events: the snapshot whenever it changed, at most `events_hz`
 //                     times a second (a comment line keeps an idle stream alive)

@@ -126,7 +126,6 @@ TEST_F(ViewerServerTest, CameraImageIsAJpegOnceTheRunPublishesOne) {
   frame.culled = {{200, 100}};
   frame.mask = cv::Mat1b(240, 320, std::uint8_t{0});
   images.publish(std::move(frame));
-  EXPECT_FALSE(images.wanted());  // throttled: not again right after one
   const auto jpeg = c.Get("/api/frame.jpg");
   ASSERT_TRUE(jpeg);
   EXPECT_EQ(jpeg->status, 200);
@@ -136,13 +135,18 @@ TEST_F(ViewerServerTest, CameraImageIsAJpegOnceTheRunPublishesOne) {
   EXPECT_EQ(static_cast<unsigned char>(jpeg->body[1]), 0xD8);
 }
 
-TEST(FrameImageSlot, NotWantedUntilAPageAsksNorAfterThePageGoes) {
-  FrameImageSlot slot(1000.0, std::chrono::milliseconds(50));
+TEST(FrameImageSlot, WantedOnlyWhileAPageAsksAndAtMostAtItsRate) {
+  // One image per 2 s at most; a page counts as gone 0.5 s after its last request.
+  FrameImageSlot slot(0.5, std::chrono::milliseconds(500));
   EXPECT_FALSE(slot.wanted());
   EXPECT_FALSE(slot.jpeg().has_value());
   EXPECT_TRUE(slot.wanted());
-  std::this_thread::sleep_for(100ms);
-  EXPECT_FALSE(slot.wanted());
+  slot.publish(FrameImage{
+      .image = cv::Mat(8, 8, CV_8UC1, cv::Scalar(0)), .kept = {}, .culled = {}, .mask = {}});
+  EXPECT_FALSE(slot.wanted());  // the next one only 2 s after this
+  EXPECT_TRUE(slot.jpeg().has_value());
+  std::this_thread::sleep_for(600ms);
+  EXPECT_FALSE(slot.wanted());  // and the page is gone by then
 }
 
 // Reads /api/events on a thread of its own until it ends; counts the data events.
