@@ -10,6 +10,7 @@ packages=(
   libspdlog-dev libfmt-dev libcli11-dev nlohmann-json3-dev libyaml-cpp-dev libzstd-dev
   libcpp-httplib-dev libsqlite3-dev
   openssl zlib1g-dev
+  chromium
 )
 missing=()
 for p in "${packages[@]}"; do
@@ -17,11 +18,19 @@ for p in "${packages[@]}"; do
     missing+=("$p")
   fi
 done
-if [ ${#missing[@]} -eq 0 ]; then
-  exit 0
-fi
-echo "deps: installing ${missing[*]}"
+# node and npm may come from elsewhere (e.g. NodeSource's nodejs bundles npm): Debian's only when absent.
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then missing+=(nodejs npm); fi
 SUDO=""
 if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-$SUDO apt-get update -qq
-DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+if [ ${#missing[@]} -gt 0 ]; then
+  echo "deps: installing ${missing[*]}"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi
+# The web viewer's libraries (three.js, uPlot; embedded into the binary) and the browser test's
+# driver (puppeteer-core), pinned by web/package-lock.json.
+web_dir="$(dirname "$0")/../web"
+if [ ! -d "$web_dir/node_modules" ]; then
+  echo "deps: npm ci in web/"
+  (cd "$web_dir" && npm ci --no-audit --no-fund --loglevel=error)
+fi

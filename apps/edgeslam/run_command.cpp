@@ -268,7 +268,8 @@ int runPipeline(const RunOptions& given) {
       makeSlamSystem(options, mode, reader->camera(), sensor, slam_options, edge);
   SlamSystem& slam = *slam_system;
   const auto viewer_attachment = viewer ? viewer->attach(slam) : nullptr;
-  viz::RunStatus view_status{.frames_total = frame_count, .mode = mode, .sensor = sensor_name};
+  viz::RunStatus view_status{
+      .frames_total = frame_count, .mode = mode, .sensor = sensor_name, .link = options.link};
   // e2e: from the frame's arrival to its pose. With --realtime a frame arrives at its due time
   // (so a client that falls behind makes later frames wait); otherwise when it has been read.
   SampleStats client_ms, load_ms, e2e_ms;
@@ -327,6 +328,19 @@ int runPipeline(const RunOptions& given) {
     frame_log.push_back({i, frame.timestamp, result.state, result.new_keyframe, result.relocalized,
                          result.tracked_points, load_ms.samples().back(), processing_ms,
                          frame_e2e_ms, stages.features_ms, stages.tracking_ms, stages.keyframe_ms});
+    {
+      FrameLogEntry& logged = frame_log.back();
+      const LinkTraffic traffic = slam.linkTraffic();
+      logged.uplink_bytes = traffic.uplink_bytes;
+      logged.downlink_bytes = traffic.downlink_bytes;
+      if (const auto* edge_slam = dynamic_cast<const EdgeSlam*>(&slam);
+          edge_slam != nullptr && edge_slam->adaptation() != nullptr) {
+        logged.adaptation_row = static_cast<int>(edge_slam->adaptation()->row());
+      }
+      if (const SemanticFrame* semantic = slam.lastSemanticFrame()) {
+        logged.features_culled = semantic->culled;
+      }
+    }
     if (result.state == TrackingState::kOk) {
       ++tracked;
     } else if (result.state == TrackingState::kLost) {
@@ -347,12 +361,15 @@ int runPipeline(const RunOptions& given) {
       view_status.keyframes = keyframes;
       view_status.map_points = map_points;
       view_status.client_ms = processing_ms;
-      const LinkTraffic traffic = slam.linkTraffic();
-      view_status.uplink_bytes = traffic.uplink_bytes;
-      view_status.downlink_bytes = traffic.downlink_bytes;
+      view_status.e2e_ms = frame_e2e_ms;
+      view_status.adaptation_row = frame_log.back().adaptation_row;
+      view_status.uplink_bytes = frame_log.back().uplink_bytes;
+      view_status.downlink_bytes = frame_log.back().downlink_bytes;
       const std::optional<SE3d> camera =
           result.T_cw ? std::optional<SE3d>(result.T_cw->inverse()) : std::nullopt;
       viewer->view().publishFrame(view_status, camera, frame.ground_truth);
+      viewer->publishImage(frame.color.empty() ? frame.gray : frame.color,
+                           slam.lastSemanticFrame());
     }
   }
   progress.finish();
@@ -558,6 +575,9 @@ int runPipeline(const RunOptions& given) {
     writeTumTrajectory(options.out_dir / "trajectory.tum", at_time);
     writeTumTrajectory(options.out_dir / "trajectory_final.tum", final_traj);
     writeTumTrajectory(options.out_dir / "keyframes.tum", slam.keyframeTrajectory());
+    // For `edgeslam report`: the dataset's poses at the frames the run read.
+    if (!ground_truth.empty())
+      writeTumTrajectory(options.out_dir / "groundtruth.tum", ground_truth);
     writeFrameLog(options.out_dir / "frames.csv", frame_log);
     std::ofstream out(options.out_dir / "metrics.json");
     out << metrics.dump(2) << "\n";

@@ -5,7 +5,9 @@
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <set>
 #include <thread>
+#include <utility>
 
 namespace edgeslam::cli {
 namespace {
@@ -35,6 +37,27 @@ RunViewer::Attachment::~Attachment() {
 std::unique_ptr<RunViewer::Attachment> RunViewer::attach(const SlamSystem& slam) {
   view_.setMapSampler([&slam](std::size_t max_points) { return slam.mapSample(max_points); });
   return std::make_unique<Attachment>(&view_);
+}
+
+void RunViewer::publishImage(const cv::Mat& image, const SemanticFrame* semantic) {
+  viz::FrameImageSlot& images = *view_.images();
+  if (!images.wanted() || image.empty()) return;
+  viz::FrameImage frame;
+  frame.image = image.clone();
+  if (semantic != nullptr && semantic->kept) {
+    std::set<std::pair<float, float>> kept;
+    for (const cv::KeyPoint& k : semantic->kept->keypoints) {
+      frame.kept.push_back(k.pt);
+      kept.emplace(k.pt.x, k.pt.y);
+    }
+    if (semantic->all && semantic->all->size() != semantic->kept->size()) {
+      for (const cv::KeyPoint& k : semantic->all->keypoints) {
+        if (!kept.contains({k.pt.x, k.pt.y})) frame.culled.push_back(k.pt);
+      }
+    }
+    frame.mask = semantic->mask.clone();
+  }
+  images.publish(std::move(frame));
 }
 
 void RunViewer::finish(double linger_seconds) {

@@ -6,6 +6,7 @@
 #include <csignal>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <thread>
 
 #include "commands.h"
@@ -13,6 +14,7 @@
 #include "network_security_options.h"
 #include "pipeline/slam_session_backend.h"
 #include "segmenter_option.h"
+#include "server_viewer.h"
 #include "vocabulary_option.h"
 
 namespace edgeslam::cli {
@@ -33,11 +35,15 @@ struct ServerOptions {
   int segment_input = 256;
   std::string maps;
   ServerSecurityOptions security;
+  std::optional<int> viewer_port;
+  std::string viewer_host = "127.0.0.1";
 };
 
 int runServer(const ServerOptions& o) {
   // First: a server that would be open to the network does not start at all.
   EdgeServerSecurity security = loadServerSecurity(o.security, o.listen);
+  std::unique_ptr<ServerViewer> viewer;
+  if (o.viewer_port) viewer = std::make_unique<ServerViewer>(o.viewer_host, *o.viewer_port);
   SlamSessionOptions options;
   options.mapping.vocabulary = loadVocabulary(o.vocabulary);
   if (o.semantic != "off") {
@@ -64,8 +70,10 @@ int runServer(const ServerOptions& o) {
   }
   const std::string& listen = o.listen;
   const int status_interval_s = o.status_interval_s;
-  EdgeServer server(listen, std::make_shared<SlamSessionFactory>(options), serverLimits(o.security),
-                    std::move(security));
+  std::shared_ptr<EdgeSessionFactory> factory = std::make_shared<SlamSessionFactory>(options);
+  if (viewer) factory = viewer->wrap(std::move(factory));
+  EdgeServer server(listen, std::move(factory), serverLimits(o.security), std::move(security));
+  const auto viewer_attachment = viewer ? viewer->attach(server) : nullptr;
   spdlog::info("edge server listening on {} (Ctrl-C to stop)", server.address());
   std::signal(SIGINT, requestStop);
   std::signal(SIGTERM, requestStop);
@@ -110,6 +118,12 @@ void addServerCommand(CLI::App& app) {
                   "Segmentation models folder (default: the shared models)");
   addMapsOption(cmd, o->maps);
   addServerSecurityOptions(*cmd, o->security);
+  cmd->add_option("--viewer", o->viewer_port,
+                  "Serve the edge view (every session's map and figures) on this port (0 = any "
+                  "free port; the URL is logged)")
+      ->check(CLI::Range(0, 65535));
+  cmd->add_option("--viewer-host", o->viewer_host,
+                  "Address the viewer listens on (0.0.0.0 = every interface)");
   cmd->callback([o] { exitCode() = runServer(*o); });
 }
 

@@ -54,6 +54,7 @@ SlamSessionBackend::~SlamSessionBackend() {
 
 void SlamSessionBackend::onKeyFrame(KeyFrameUpload upload) {
   if (!mapping_) {
+    std::lock_guard view_lock(view_mutex_);
     EdgeMapSessionOptions mapping = options_.mapping;
     mapping.mapper.observe_recent_points = true;
     mapping.segmenter = segmenter_;
@@ -104,6 +105,7 @@ std::optional<OffloadResult> SlamSessionBackend::onFrame(OffloadFrame frame) {
     raw.convertTo(depth, CV_32F, 1.0 / 1000.0);
   }
   if (!offload_) {
+    std::lock_guard view_lock(view_mutex_);
     SlamOptions slam_options = defaultSlamOptions(config_.camera, config_.sensor);
     slam_options.orb.num_features = config_.settings.features;
     slam_options.orb.num_levels = config_.settings.pyramid_levels;
@@ -122,6 +124,27 @@ std::optional<OffloadResult> SlamSessionBackend::onFrame(OffloadFrame frame) {
   result.T_cw = tracked.T_cw;
   result.server_ms = timer.elapsedMs();
   return result;
+}
+
+MapSample SlamSessionBackend::mapSample(std::size_t max_points) const {
+  std::lock_guard view_lock(view_mutex_);
+  if (offload_) return offload_->mapSample(max_points);
+  MapSample sample;
+  if (!mapping_) return sample;
+  const Map& map = mapping_->map();
+  std::lock_guard lock(map.updateMutex());
+  for (const KeyFrame* kf : map.keyFrames()) {
+    if (!kf->isBad()) sample.keyframe_poses.push_back(kf->poseInverse());
+  }
+  sample.points = map.pointPositionSample(max_points);
+  sample.total_points = map.pointCount();
+  return sample;
+}
+
+std::size_t SlamSessionBackend::loops() const {
+  std::lock_guard view_lock(view_mutex_);
+  if (mapping_ && mapping_->loopCloser() != nullptr) return mapping_->loopCloser()->loops();
+  return 0;
 }
 
 std::unique_ptr<EdgeSessionBackend> SlamSessionFactory::open(const SessionConfig& config,

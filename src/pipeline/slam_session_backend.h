@@ -31,9 +31,16 @@ class SlamSessionBackend : public EdgeSessionBackend {
   void onKeyFrame(KeyFrameUpload upload) override;
   std::optional<OffloadResult> onFrame(OffloadFrame frame) override;
 
+  // For a viewer, from any thread: the session's map now (its global map in edge mode, the
+  // offloaded SLAM's map in offload mode; empty before the first keyframe or frame) and the loops
+  // it closed.
+  MapSample mapSample(std::size_t max_points) const;
+  std::size_t loops() const;
+
  private:
   void startStoreWriter();
 
+  mutable std::mutex view_mutex_;  // guards making mapping_ and offload_, for the viewer
   SessionConfig config_;
   SliceSink& sink_;
   SlamSessionOptions options_;

@@ -15,8 +15,10 @@
 
 #include "geometry/se3.h"
 #include "pipeline/slam_system.h"
+#include "viz/frame_image_slot.h"
 #include "viz/trajectory_decimator.h"
 #include "viz/view_snapshot.h"
+#include "viz/view_source.h"
 
 namespace edgeslam::viz {
 
@@ -31,7 +33,7 @@ struct LiveViewOptions {
 // viewer's threads (so it must lock what the map needs).
 using MapSampler = std::function<MapSample(std::size_t max_points)>;
 
-class LiveView {
+class LiveView : public ViewSource {
  public:
   explicit LiveView(LiveViewOptions options = {});
 
@@ -46,14 +48,17 @@ class LiveView {
 
   ViewSnapshot snapshot();
   // toJson(snapshot()).dump(), encoded at most once per change and shared by every reader.
-  std::string snapshotJson();
+  std::string snapshotJson() override;
   std::uint64_t version() const;
+  // The camera image of the mobile view (/api/frame.jpg).
+  FrameImageSlot* images() override { return &images_; }
 
  private:
   void refreshMapIfDue();         // holds map_mutex_
   ViewSnapshot snapshotLocked();  // holds map_mutex_, the map already refreshed
 
   LiveViewOptions options_;
+  FrameImageSlot images_;
 
   mutable std::mutex frame_mutex_;  // what the run loop publishes
   std::uint64_t version_ = 0;

@@ -46,10 +46,13 @@ nlohmann::json statusJson(const RunStatus& s) {
           {"keyframes", s.keyframes},
           {"map_points", s.map_points},
           {"client_ms", rounded(s.client_ms, 100.0)},
+          {"e2e_ms", rounded(s.e2e_ms, 100.0)},
           {"uplink_bytes", s.uplink_bytes},
           {"downlink_bytes", s.downlink_bytes},
           {"mode", s.mode},
           {"sensor", s.sensor},
+          {"link", s.link},
+          {"adaptation_row", s.adaptation_row},
           {"finished", s.finished}};
 }
 
@@ -62,7 +65,8 @@ nlohmann::json toJson(const ViewSnapshot& snapshot) {
   }
   std::optional<nlohmann::json> camera;
   if (snapshot.camera) camera = poseJson(*snapshot.camera);
-  return {{"version", snapshot.version},
+  return {{"view", "mobile"},
+          {"version", snapshot.version},
           {"status", statusJson(snapshot.status)},
           {"camera", camera ? *camera : nlohmann::json(nullptr)},
           {"trajectory", flatPositions(snapshot.trajectory)},

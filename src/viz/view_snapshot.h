@@ -22,11 +22,14 @@ struct RunStatus {
   std::size_t keyframes = 0;
   std::size_t map_points = 0;
   double client_ms = 0.0;  // the latest frame's client processing time
+  double e2e_ms = 0.0;     // the latest frame's end-to-end latency (arrival to pose)
   std::uint64_t uplink_bytes = 0;
   std::uint64_t downlink_bytes = 0;
   std::string mode;
   std::string sensor;
-  bool finished = false;  // the run is over (the viewer lingers on the final map)
+  std::string link;         // the emulated link profile ("none" without one)
+  int adaptation_row = -1;  // Table I row in use (0-based); -1 without self-adaptation
+  bool finished = false;    // the run is over (the viewer lingers on the final map)
 };
 
 struct ViewPose {

@@ -24,7 +24,7 @@ void runAtNice(int nice) {
 
 }  // namespace
 
-ViewerServer::ViewerServer(ViewerServerOptions options, LiveView& view)
+ViewerServer::ViewerServer(ViewerServerOptions options, ViewSource& view)
     : options_(std::move(options)), view_(view), server_(std::make_unique<httplib::Server>()) {
   if (options_.port < 0 || options_.port > 65535) {
     throw ViewerError(
@@ -103,6 +103,18 @@ void ViewerServer::addRoutes() {
     runAtNice(options_.thread_nice);
     res.set_header("Cache-Control", "no-cache");
     res.set_content(view_.snapshotJson(), "application/json");
+  });
+  server_->Get("/api/frame.jpg", [this](const httplib::Request&, httplib::Response& res) {
+    runAtNice(options_.thread_nice);
+    res.set_header("Cache-Control", "no-store");
+    FrameImageSlot* images = view_.images();
+    std::optional<std::string> jpeg = images ? images->jpeg() : std::nullopt;
+    if (!jpeg) {
+      res.status = 404;
+      res.set_content("no camera image\n", "text/plain");
+      return;
+    }
+    res.set_content(std::move(*jpeg), "image/jpeg");
   });
   server_->Get("/api/events", [this](const httplib::Request&, httplib::Response& res) {
     res.set_header("Cache-Control", "no-cache");

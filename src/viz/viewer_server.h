@@ -1,9 +1,11 @@
 #pragma once
 // The web viewer's HTTP server (cpp-httplib, on threads of its own):
 //   GET /             the page          GET /app.js, /style.css  its script and style
+//   GET /lib/...      the libraries the page loads (three.js, uPlot; see web_assets.h)
 //   GET /api/state    the latest snapshot as JSON (view_snapshot.h)
 //   GET /api/events   Server-Sent Events: the snapshot whenever it changed, at most `events_hz`
 //                     times a second (a comment line keeps an idle stream alive)
+//   GET /api/frame.jpg the camera image with its features (mobile view; 404 before the first)
 //   GET /api/health   "ok"
 // Anything else is 404. The files are built into the binary (web_assets.h).
 #include <atomic>
@@ -14,7 +16,7 @@
 #include <string>
 #include <thread>
 
-#include "viz/live_view.h"
+#include "viz/view_source.h"
 
 namespace httplib {
 class Server;
@@ -39,7 +41,7 @@ struct ViewerServerOptions {
 class ViewerServer {
  public:
   // Binds and starts serving; throws ViewerError when it cannot (a bad or taken port, a bad host).
-  ViewerServer(ViewerServerOptions options, LiveView& view);
+  ViewerServer(ViewerServerOptions options, ViewSource& view);
   ~ViewerServer();
   ViewerServer(const ViewerServer&) = delete;
   ViewerServer& operator=(const ViewerServer&) = delete;
@@ -56,7 +58,7 @@ class ViewerServer {
   bool waitForNextEvent();
 
   ViewerServerOptions options_;
-  LiveView& view_;
+  ViewSource& view_;
   std::unique_ptr<httplib::Server> server_;
   int port_ = 0;
   std::thread thread_;

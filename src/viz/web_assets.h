@@ -1,6 +1,7 @@
 #pragma once
-// The viewer's page, script and style (web/), built into the binary (embed_web_assets.cmake
-// writes web_assets.cpp), so that the binary serves them wherever it is copied.
+// The viewer's page, script and style (web/) and the libraries it loads (three.js, OrbitControls,
+// uPlot from web/node_modules, served under /lib/), built into the binary (embed_web_assets.cmake
+// writes web_assets.cpp), so that the binary serves them wherever it is copied, offline.
 #include <string_view>
 #include <vector>
 

@@ -10,6 +10,8 @@
 #include <nlohmann/json.hpp>
 #include <thread>
 
+#include "viz/live_view.h"
+
 namespace edgeslam::viz {
 namespace {
 
@@ -54,7 +56,8 @@ TEST_F(ViewerServerTest, ServesThePageScriptAndStyle) {
   const auto page = c.Get("/");
   ASSERT_TRUE(page) << httplib::to_string(page.error());
   EXPECT_EQ(page->status, 200);
-  EXPECT_NE(page->body.find("<canvas"), std::string::npos);
+  EXPECT_NE(page->body.find("<div id=\"view\""), std::string::npos);
+  EXPECT_NE(page->body.find("importmap"), std::string::npos);
   EXPECT_NE(page->get_header_value("Content-Type").find("text/html"), std::string::npos);
   const auto script = c.Get("/app.js");
   ASSERT_TRUE(script);
@@ -64,6 +67,19 @@ TEST_F(ViewerServerTest, ServesThePageScriptAndStyle) {
   const auto style = c.Get("/style.css");
   ASSERT_TRUE(style);
   EXPECT_EQ(style->status, 200);
+  // The libraries the page loads are served from the binary: it works without internet.
+  for (const char* path : {"/lib/three.module.min.js", "/lib/three.core.min.js",
+                           "/lib/OrbitControls.js", "/lib/uPlot.iife.min.js"}) {
+    const auto library = c.Get(path);
+    ASSERT_TRUE(library) << path;
+    EXPECT_EQ(library->status, 200) << path;
+    EXPECT_GT(library->body.size(), 10000u) << path;
+    EXPECT_NE(library->get_header_value("Content-Type").find("javascript"), std::string::npos);
+  }
+  const auto library_style = c.Get("/lib/uPlot.min.css");
+  ASSERT_TRUE(library_style);
+  EXPECT_EQ(library_style->status, 200);
+  EXPECT_NE(library_style->body.find(".uplot"), std::string::npos);
   const auto health = c.Get("/api/health");
   ASSERT_TRUE(health);
   EXPECT_EQ(health->status, 200);
@@ -94,6 +110,43 @@ TEST_F(ViewerServerTest, StateIsTheSnapshotAsJson) {
   EXPECT_EQ(state["status"]["mode"], "local");
   EXPECT_EQ(state["points"].size(), 6u);
   EXPECT_EQ(state["keyframes"].size(), 1u);
+}
+
+TEST_F(ViewerServerTest, CameraImageIsAJpegOnceTheRunPublishesOne) {
+  auto c = client();
+  const auto none = c.Get("/api/frame.jpg");
+  ASSERT_TRUE(none);
+  EXPECT_EQ(none->status, 404);
+  // The page asked: the run loop is now asked for an image, and only then.
+  FrameImageSlot& images = *view_.images();
+  ASSERT_TRUE(images.wanted());
+  FrameImage frame;
+  frame.image = cv::Mat(240, 320, CV_8UC1, cv::Scalar(128));
+  frame.kept = {{10, 10}, {100, 50}};
+  frame.culled = {{200, 100}};
+  frame.mask = cv::Mat1b(240, 320, std::uint8_t{0});
+  images.publish(std::move(frame));
+  const auto jpeg = c.Get("/api/frame.jpg");
+  ASSERT_TRUE(jpeg);
+  EXPECT_EQ(jpeg->status, 200);
+  EXPECT_EQ(jpeg->get_header_value("Content-Type"), "image/jpeg");
+  ASSERT_GT(jpeg->body.size(), 2u);
+  EXPECT_EQ(static_cast<unsigned char>(jpeg->body[0]), 0xFF);
+  EXPECT_EQ(static_cast<unsigned char>(jpeg->body[1]), 0xD8);
+}
+
+TEST(FrameImageSlot, WantedOnlyWhileAPageAsksAndAtMostAtItsRate) {
+  // One image per 2 s at most; a page counts as gone 0.5 s after its last request.
+  FrameImageSlot slot(0.5, std::chrono::milliseconds(500));
+  EXPECT_FALSE(slot.wanted());
+  EXPECT_FALSE(slot.jpeg().has_value());
+  EXPECT_TRUE(slot.wanted());
+  slot.publish(FrameImage{
+      .image = cv::Mat(8, 8, CV_8UC1, cv::Scalar(0)), .kept = {}, .culled = {}, .mask = {}});
+  EXPECT_FALSE(slot.wanted());  // the next one only 2 s after this
+  EXPECT_TRUE(slot.jpeg().has_value());
+  std::this_thread::sleep_for(600ms);
+  EXPECT_FALSE(slot.wanted());  // and the page is gone by then
 }
 
 // Reads /api/events on a thread of its own until it ends; counts the data events.

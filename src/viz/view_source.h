@@ -1,0 +1,19 @@
+#pragma once
+// What the viewer's HTTP server shows: a run's LiveView (the mobile view) or an edge server's
+// EdgeView. Called from the viewer's threads.
+#include <string>
+
+#include "viz/frame_image_slot.h"
+
+namespace edgeslam::viz {
+
+class ViewSource {
+ public:
+  virtual ~ViewSource() = default;
+  // The snapshot as JSON (docs/viewer.md); may be a cached encoding shared by every page.
+  virtual std::string snapshotJson() = 0;
+  // The camera image, where the view has one.
+  virtual FrameImageSlot* images() { return nullptr; }
+};
+
+}  // namespace edgeslam::viz
