@@ -75,9 +75,10 @@ TEST(RunCommand, WritesTheContractOutputs) {
 }
 
 // KITTI 07's calibration bends the monocular map in its first turn; the end-of-run self-calibration
+// finds the images' focal length and k1, and a second run started from camera_refined.yaml tracks
 // with them live (docs/self_calibration.md). Frames fed back to back: tracking waits for the
 // mapper, so the map does not depend on the host's load (a paced run drops the frames it is late
-// for). with them live (docs/self_calibration.md).
+// for).
 TEST(RunCommand, LocalRunSelfCalibratesAndTheRefinedCameraCarriesOver) {
   EDGESLAM_REQUIRE_SHARED("datasets/kitti07-160");
   const std::string kitti = test::sharedPath("datasets/kitti07-160").string();
