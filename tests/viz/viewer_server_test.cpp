@@ -1,6 +1,9 @@
 // The viewer's HTTP server on a free loopback port, talked to with httplib's client.
 #include "viz/viewer_server.h"
 
+// clang-format off: before httplib.h, whose macros break Eigen's headers.
+#include "viz/live_view.h"
+// clang-format on
 #include <gtest/gtest.h>
 #include <httplib.h>
 
@@ -9,8 +12,6 @@
 #include <future>
 #include <nlohmann/json.hpp>
 #include <thread>
-
-#include "viz/live_view.h"
 
 namespace edgeslam::viz {
 namespace {
