@@ -150,8 +150,9 @@ MapPoint* upsertPointRecord(Map& map, const MapPointRecord& record,
     map.setPointPosition(point, record.position);
     // Observations the other side dropped (outliers, culled keyframes) go here too.
     for (const auto& [id, obs] : point->observations()) {
+      KeyFrame* const observer = obs.keyframe;  // a lambda cannot capture a binding (clang 14)
       const bool kept = std::any_of(observers.begin(), observers.end(),
-                                    [&](const auto& o) { return o.first == obs.keyframe; });
+                                    [&](const auto& o) { return o.first == observer; });
       // Edge-made keyframes (origin 0) are always known to the edge; a client's are known up
       // to the newest one the edge had received.
       const bool sender_knew =
