@@ -121,9 +121,16 @@ grpc::Status EdgeService::OpenSession(grpc::ServerContext* context,
   const AccessGrant* grant = nullptr;
   if (grpc::Status status = authenticate(*context, &grant); !status.ok()) return status;
   if (stopping_.load()) return {grpc::StatusCode::UNAVAILABLE, "the edge server is shutting down"};
-  std::string map = kDefaultMapName;
+  SessionConfig config;
+  try {
+    config = fromProto(*request);
+  } catch (const WireError& e) {
+    return invalid(e);
+  }
+  // The map the session names (`--map`); a balancer in front may carry it as metadata instead.
+  std::string map = config.map_name.empty() ? kDefaultMapName : config.map_name;
   if (const auto found = context->client_metadata().find(kMapMetadataKey);
-      found != context->client_metadata().end()) {
+      config.map_name.empty() && found != context->client_metadata().end()) {
     map.assign(found->second.data(), found->second.size());
   }
   if (grant != nullptr && !grant->permitsMap(map)) {
@@ -132,12 +139,6 @@ grpc::Status EdgeService::OpenSession(grpc::ServerContext* context,
   }
   SessionOwner owner;
   if (grant != nullptr) owner = {grant->label, limits_.max_sessions_per_client};
-  SessionConfig config;
-  try {
-    config = fromProto(*request);
-  } catch (const WireError& e) {
-    return invalid(e);
-  }
   std::shared_ptr<ServerSession> session;
   try {
     session = registry_.open(std::move(config), *factory_, owner);
