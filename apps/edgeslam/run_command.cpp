@@ -305,10 +305,12 @@ int runPipeline(const RunOptions& given) {
         std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(wait_ms));
     }
     if (frame.ground_truth) ground_truth.push_back({frame.timestamp, *frame.ground_truth});
-    // Like a camera driver that keeps the newest frame: once the next frame is due, this one is
-    // stale and dropped, so a client slower than the camera skips frames instead of lagging more.
+    // Like a camera driver that keeps the newest frame: once the next frame is due and delivered,
+    // this one is stale and dropped, so a client slower than the camera skips frames instead of
+    // lagging more. A frame the reader has not delivered yet is no newer frame (a starved reading
+    // thread is the host's lateness, not the client's).
     if (options.realtime && i + 1 < frame_count &&
-        wall.elapsedMs() > (stamps[i + 1] - stamps[0]) * 1000.0) {
+        wall.elapsedMs() > (stamps[i + 1] - stamps[0]) * 1000.0 && prefetcher->nextIsReady()) {
       ++frames_dropped_late;
       continue;
     }

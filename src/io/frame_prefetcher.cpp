@@ -71,4 +71,9 @@ PrefetchedFrame FramePrefetcher::next() {
   return out;
 }
 
+bool FramePrefetcher::nextIsReady() {
+  MutexLock lock(mutex_);
+  return !ready_.empty();
+}
+
 }  // namespace edgeslam

@@ -37,6 +37,8 @@ class FramePrefetcher {
   // The next frame in order, waiting for it if needed. Rethrows what reading it threw; throws
   // std::out_of_range past the last frame.
   PrefetchedFrame next();
+  // Whether the frame after the last one handed out is read already (a camera has delivered it).
+  bool nextIsReady();
 
  private:
   void run();

@@ -45,7 +45,8 @@ void Map::addObservation(MapPoint* point, KeyFrame* keyframe, std::size_t index)
   if (keyframe->points_[index] != nullptr && keyframe->points_[index] != point) {
     eraseObservation(keyframe->points_[index], keyframe);
   }
-  const auto [it, inserted] = point->observations_.try_emplace(keyframe->id(), MapPoint::Observation{keyframe, index});
+  const auto [it, inserted] =
+      point->observations_.try_emplace(keyframe->id(), MapPoint::Observation{keyframe, index});
   if (!inserted) {
     if (it->second.index == index) return;
     keyframe->points_[it->second.index] = nullptr;

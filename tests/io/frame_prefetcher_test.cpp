@@ -100,6 +100,20 @@ TEST(FramePrefetcher, ReadsNoFurtherAheadThanAsked) {
   EXPECT_EQ(reader.loads.load(), 6u);
 }
 
+TEST(FramePrefetcher, TellsWhetherTheNextFrameIsReadAlready) {
+  CountingReader reader(2, kNever, std::chrono::milliseconds(0));
+  FramePrefetcher prefetcher(reader, 2, {.frames_ahead = 2});
+  EXPECT_FALSE(reader.loaded.load() == 0 && prefetcher.nextIsReady());
+  prefetcher.next();
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+  while (!prefetcher.nextIsReady() && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  EXPECT_TRUE(prefetcher.nextIsReady());
+  prefetcher.next();
+  EXPECT_FALSE(prefetcher.nextIsReady());  // nothing after the last frame
+}
+
 TEST(FramePrefetcher, ReadsWhileTheConsumerWorks) {
   // 100 ms per read: while the consumer works on frame 0, frames 1-4 are read, and taking them
   // then costs no read at all.
