@@ -14,8 +14,8 @@
 #include <functional>
 
 #include "map/keyframe_sink.h"
-#include "util/timing_stats.h"
 #include "util/mutex.h"
+#include "util/timing_stats.h"
 
 namespace edgeslam {
 
