@@ -11,6 +11,8 @@ EDGESLAM_DATA ?= $(EDGESLAM_SHARED)/datasets/7scenes-redkitchen-1000
 DEMO_OUT ?= out/demo
 DEMO_ARGS ?=
 export EDGESLAM_SHARED
+# ccache hashes paths relative to the checkout, so a clone elsewhere (CI's) reuses the cache.
+export CCACHE_BASEDIR ?= $(CURDIR)
 
 .PHONY: all deps configure build vocab test test-release test-sanitize test-tsan test-host-timing demo bench format format-check clean
 .PHONY: fuzz
