@@ -23,6 +23,7 @@
 #include "eval/alignment.h"
 #include "eval/association.h"
 #include "eval/ate.h"
+#include "eval/markup_escape.h"
 #include "io/trajectory.h"
 #include "viz/web_assets.h"
 
@@ -59,26 +60,6 @@ std::string scriptSafe(std::string_view text) {
   for (std::size_t i = 0; i < text.size(); ++i) {
     out += text[i];
     if (text[i] == '<' && i + 1 < text.size() && text[i + 1] == '/') out += "\\";
-  }
-  return out;
-}
-
-std::string htmlEscaped(std::string_view text) {
-  std::string out;
-  for (const char c : text) {
-    switch (c) {
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '&':
-        out += "&amp;";
-        break;
-      default:
-        out += c;
-    }
   }
   return out;
 }
@@ -174,7 +155,8 @@ void flattenMetrics(const nlohmann::json& value, const std::string& prefix, std:
   if (value.is_array() && value.size() > 8) return;
   std::string text = value.is_string() ? value.get<std::string>() : value.dump();
   if (value.is_number_float()) text = fmt::format("{:.6g}", value.get<double>());
-  rows += fmt::format("<tr><th>{}</th><td>{}</td></tr>\n", htmlEscaped(prefix), htmlEscaped(text));
+  rows +=
+      fmt::format("<tr><th>{}</th><td>{}</td></tr>\n", escapeMarkup(prefix), escapeMarkup(text));
 }
 
 constexpr const char* kStyle = R"(
@@ -237,8 +219,8 @@ int writeReport(const ReportOptions& o) {
 <script>{8}</script>
 </body></html>
 )",
-      htmlEscaped(title), webAsset("/lib/uPlot.min.css"), kStyle, estimate.size(),
-      htmlEscaped(truth_note), rows, scriptSafe(webAsset("/lib/uPlot.iife.min.js")),
+      escapeMarkup(title), webAsset("/lib/uPlot.min.css"), kStyle, estimate.size(),
+      escapeMarkup(truth_note), rows, scriptSafe(webAsset("/lib/uPlot.iife.min.js")),
       scriptSafe(data.dump()), scriptSafe(webAsset("/report.js")));
   const fs::path output = o.output.empty() ? dir / "report.html" : o.output;
   std::ofstream out(output, std::ios::binary);

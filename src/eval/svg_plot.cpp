@@ -10,6 +10,7 @@
 
 #include "eval/colormap.h"
 #include "eval/eval_error.h"
+#include "eval/markup_escape.h"
 
 namespace edgeslam {
 namespace {
@@ -22,29 +23,6 @@ constexpr double kTop = 84.0;
 constexpr double kRight = 800.0;
 constexpr double kBottom = 690.0;
 constexpr int kColourLevels = 64;
-
-std::string escapeXml(const std::string& text) {
-  std::string out;
-  for (const char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
 
 // 1, 2 or 5 times a power of ten, near `raw`.
 double niceStep(double raw) {
@@ -277,7 +255,7 @@ void drawColourBar(std::string& svg, double e_hi, const std::string& label) {
   svg += fmt::format(
       "<text x=\"{:.1f}\" y=\"{:.1f}\" font-size=\"13\" text-anchor=\"middle\" "
       "fill=\"#333\">{}</text>\n",
-      x + 11.0, top - 14.0, escapeXml(label));
+      x + 11.0, top - 14.0, escapeMarkup(label));
   if (!(e_hi > 0.0)) e_hi = 1.0;
   const double step = niceStep(e_hi / 5.0);
   const auto pixel = [&](double value) { return bottom - value / e_hi * (bottom - top); };
@@ -333,9 +311,9 @@ std::string renderTrajectorySvg(const TrajectoryPlot& plot) {
   svg += fmt::format("<rect width=\"{}\" height=\"{}\" fill=\"white\"/>\n", kWidth, kHeight);
   svg += fmt::format(
       "<text x=\"{:.1f}\" y=\"34\" font-size=\"20\" font-weight=\"bold\" fill=\"#111\">{}</text>\n",
-      kLeft, escapeXml(plot.title));
+      kLeft, escapeMarkup(plot.title));
   svg += fmt::format("<text x=\"{:.1f}\" y=\"58\" font-size=\"13\" fill=\"#555\">{}</text>\n",
-                     kLeft, escapeXml(plot.subtitle));
+                     kLeft, escapeMarkup(plot.subtitle));
   static constexpr const char kAxisNames[] = "xyz";
   drawGrid(svg, view, kAxisNames);
 
