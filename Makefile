@@ -15,7 +15,7 @@ export EDGESLAM_SHARED
 export CCACHE_BASEDIR ?= $(CURDIR)
 
 .PHONY: all deps configure build vocab test test-release test-sanitize test-tsan test-host-timing demo bench format format-check clean
-.PHONY: fuzz
+.PHONY: fuzz sanitize-build
 
 all: build
 
@@ -51,13 +51,17 @@ test-host-timing: build
 	@cd $(BUILD_DIR) && ctest --output-on-failure --timeout 900 -R "$(HOST_SENSITIVE_TESTS)" \
 	  --repeat until-pass:5
 
-# The sanitizer build runs the fast unit tests only (label "unit"); CI runs it when CI is set.
-test-sanitize: deps
-	@cmake -S . -B $(ASAN_DIR) -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DEDGESLAM_WERROR=$(WERROR) \
-	  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1" -DEDGESLAM_SANITIZE=ON \
+# The sanitizer build (clang, ASan+UBSan, with the fuzzer's coverage so the harnesses of tests/fuzz
+# come from the same build) runs the fast unit tests only (label "unit"); CI runs it when CI is set.
+sanitize-build: deps
+	@CC=clang CXX=clang++ cmake -S . -B $(ASAN_DIR) -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+	  -DEDGESLAM_WERROR=$(WERROR) -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -gline-tables-only" \
+	  -DEDGESLAM_SANITIZE=ON -DEDGESLAM_FUZZ=ON -DEDGESLAM_BUILD_BENCH=OFF \
 	  -DEDGESLAM_SHARED_DIR=$(EDGESLAM_SHARED) > /dev/null
-	@cmake --build $(ASAN_DIR) -j $(JOBS) --target unit-tests
-	@cd $(ASAN_DIR) && ctest --output-on-failure -j $(JOBS) -L unit --timeout 900
+	@cmake --build $(ASAN_DIR) -j $(JOBS) --target unit-tests edgeslam_fuzzers
+
+test-sanitize: sanitize-build
+	@cd $(ASAN_DIR) && ctest --output-on-failure -j $(JOBS) -L unit --timeout 900 -E "$(CLANG_NUMERIC_TESTS)"
 
 # The clang build: -Wthread-safety checks the lock annotations at compile time (warnings are
 # errors), and ThreadSanitizer watches the unit tests run. -O1 with line tables only keeps it quick.
@@ -74,19 +78,14 @@ test-tsan: deps
 CLANG_NUMERIC_TESTS := LocalMapperBow.DescribesKeyFramesAndTriangulatesThroughTheDirectIndex|PoseOptimizer.StereoObservationsImproveDepth|IntrinsicsRefinement.RecoversFocalLengthAndRadialDistortion
 
 test: test-release
-	@if [ -n "$$CI" ]; then $(MAKE) --no-print-directory test-sanitize test-tsan; fi
+	@if [ -n "$$CI" ]; then $(MAKE) --no-print-directory test-sanitize fuzz test-tsan; fi
 
-# libFuzzer harnesses (tests/fuzz) built by clang with ASan into $(FUZZ_DIR), each run for
-# FUZZ_SECONDS on a corpus kept in $(FUZZ_DIR)/fuzz-corpus, seeded from real messages and files;
-# prints executions per harness and fails on any crash (saved in $(FUZZ_DIR)/fuzz-crashes).
-FUZZ_DIR ?= build-fuzz
+# libFuzzer harnesses (tests/fuzz), from the sanitizer build, each run for FUZZ_SECONDS on a corpus
+# kept in $(ASAN_DIR)/fuzz-corpus, seeded from real messages and files; prints executions per
+# harness and fails on any crash (the input is saved in $(ASAN_DIR)/fuzz-crashes).
 FUZZ_SECONDS ?= 20
-fuzz: deps
-	@cmake -S . -B $(FUZZ_DIR) -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-	  -DCMAKE_CXX_COMPILER=/usr/bin/clang++ -DEDGESLAM_FUZZ=ON -DEDGESLAM_BUILD_TESTS=OFF \
-	  -DEDGESLAM_BUILD_BENCH=OFF -DEDGESLAM_WERROR=OFF -DEDGESLAM_SHARED_DIR=$(EDGESLAM_SHARED) > /dev/null
-	@cmake --build $(FUZZ_DIR) -j $(JOBS) --target edgeslam_fuzzers
-	@FUZZ_DIR=$(FUZZ_DIR) FUZZ_SECONDS=$(FUZZ_SECONDS) bash scripts/fuzz.sh
+fuzz: sanitize-build
+	@FUZZ_DIR=$(ASAN_DIR) FUZZ_SECONDS=$(FUZZ_SECONDS) bash scripts/fuzz.sh
 
 demo: vocab
 	@./$(BUILD_DIR)/edgeslam run --dataset "$(EDGESLAM_DATA)" --mode edge --out $(DEMO_OUT) $(DEMO_ARGS)
@@ -106,4 +105,4 @@ format-check:
 	@git ls-files '*.cpp' '*.h' | xargs clang-format --dry-run --Werror
 
 clean:
-	rm -rf $(BUILD_DIR) $(ASAN_DIR) $(FUZZ_DIR)
+	rm -rf $(BUILD_DIR) $(ASAN_DIR) $(TSAN_DIR)

@@ -1,15 +1,14 @@
 #!/usr/bin/env bash
 # Runs every libFuzzer harness of $FUZZ_DIR for $FUZZ_SECONDS seconds (`make fuzz`), on a corpus
-# that grows across runs, seeded once from real messages and files (fuzz_seeds). Prints the
+# that grows across runs, seeded from real messages and files (fuzz_seeds, rewritten each run). Prints the
 # executions of each; exits 1 when a harness found a crash (its input is in fuzz-crashes/).
 set -uo pipefail
-FUZZ_DIR=${FUZZ_DIR:-build-fuzz}
+FUZZ_DIR=${FUZZ_DIR:-build-asan}
 FUZZ_SECONDS=${FUZZ_SECONDS:-20}
 SHARED=${EDGESLAM_SHARED:-$(cd "$(dirname "$0")/../.." && pwd)/shared}
 seeds="$FUZZ_DIR/fuzz-seeds"
-if [ ! -d "$seeds" ]; then
-  "$FUZZ_DIR/tests/fuzz/fuzz_seeds" "$seeds" "$SHARED" || exit 1
-fi
+rm -rf "$seeds"
+"$FUZZ_DIR/tests/fuzz/fuzz_seeds" "$seeds" "$SHARED" || exit 1
 mkdir -p "$FUZZ_DIR/fuzz-corpus" "$FUZZ_DIR/fuzz-crashes" "$FUZZ_DIR/fuzz-logs"
 failed=0
 printf '%-24s %12s %10s %s\n' harness executions exec/s result
@@ -20,8 +19,10 @@ for harness in "$FUZZ_DIR"/tests/fuzz/fuzz_*; do
   corpus="$FUZZ_DIR/fuzz-corpus/$name"
   mkdir -p "$corpus" "$seeds/$name"
   log="$FUZZ_DIR/fuzz-logs/$name.log"
+  max_len=65536
+  [ "$name" = fuzz_map_store ] && max_len=262144  # a whole (small) database file
   timeout -k 10 $((FUZZ_SECONDS + 120)) "$harness" "$corpus" "$seeds/$name" \
-    -max_total_time="$FUZZ_SECONDS" -max_len=65536 -timeout=10 -rss_limit_mb=2048 \
+    -max_total_time="$FUZZ_SECONDS" -max_len=$max_len -timeout=10 -rss_limit_mb=2048 \
     -print_final_stats=1 -artifact_prefix="$FUZZ_DIR/fuzz-crashes/$name-" >"$log" 2>&1
   status=$?
   executions=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -1)

@@ -17,6 +17,7 @@
 #include "io/camera_file.h"
 #include "io/dataset.h"
 #include "io/frame_prefetcher.h"
+#include "io/frame_range.h"
 #include "io/trajectory.h"
 #include "link/link_settings.h"
 #include "map_store_option.h"
@@ -40,7 +41,11 @@ namespace edgeslam::cli {
 namespace {
 
 nlohmann::json toJson(const PercentileSummary& s) {
-  return {{"median", s.median}, {"p90", s.p90}, {"p99", s.p99}, {"max", s.max}};
+  return {{"median", s.median}, {"p90", s.p90}, {"p95", s.p95}, {"p99", s.p99}, {"max", s.max}};
+}
+
+nlohmann::json frameRangeJson(const std::optional<FrameRange>& range, std::size_t played) {
+  return {{"first", range ? range->first : 0}, {"count", played}};
 }
 
 nlohmann::json keyFrameDecisionsJson(const KeyFrameDecisionCounts& c) {
@@ -182,6 +187,13 @@ int runPipeline(const RunOptions& given) {
   dataset_options.format = parseDatasetFormat(options.format);
   if (options.camera_file) dataset_options.camera_override = loadCameraFile(*options.camera_file);
   auto reader = openDataset(options.dataset, dataset_options);
+  if (options.frames) {
+    try {
+      reader = selectFrames(std::move(reader), *options.frames);
+    } catch (const std::invalid_argument& e) {
+      throw CLI::ValidationError("--frames", e.what());  // a usage error, known once the data is
+    }
+  }
   const DatasetInfo& info = reader->info();
   const std::string sensor_name = resolveSensor(options.sensor, info);
   if (sensor_name == "stereo") {
@@ -428,6 +440,7 @@ int runPipeline(const RunOptions& given) {
                             {"requested_mode", options.mode},
                             {"sensor", sensor_name},
                             {"dataset", info.path.string()},
+                            {"dataset_frames", frameRangeJson(options.frames, frame_count)},
                             {"wall_s", seconds},
                             {"pacing", options.realtime ? "realtime" : "fast"},
                             {"frames_dropped_late", frames_dropped_late},
@@ -436,6 +449,7 @@ int runPipeline(const RunOptions& given) {
                              {{"total", counters.backend.wait_total_ms},
                               {"median", counters.backend.wait_ms.median},
                               {"p90", counters.backend.wait_ms.p90},
+                              {"p95", counters.backend.wait_ms.p95},
                               {"p99", counters.backend.wait_ms.p99},
                               {"max", counters.backend.wait_ms.max}}},
                             {"backend_busy_refusals", counters.backend.busy_refusals},
@@ -486,7 +500,8 @@ int runPipeline(const RunOptions& given) {
       metrics["client_triangulation"] = {
           {"keyframes", t.keyframes},
           {"points_created", t.points_created},
-          {"ms_per_keyframe", {{"median", ms.median}, {"p90", ms.p90}, {"max", ms.max}}}};
+          {"ms_per_keyframe",
+           {{"median", ms.median}, {"p90", ms.p90}, {"p95", ms.p95}, {"max", ms.max}}}};
     }
   }
   if (options.semantic || semantic_eval) {
@@ -643,6 +658,20 @@ void addRunOptions(CLI::App* run, const std::shared_ptr<RunOptions>& options) {
       ->check(CLI::Range(0, 300))
       ->capture_default_str();
   run->add_option("--max-frames", options->max_frames, "Process at most N frames (0 = all)");
+  run->add_option_function<std::string>(
+         "--frames",
+         [options](const std::string& text) { options->frames = parseFrameRange(text); },
+         "Play only frames A-B of the dataset (0-based, inclusive), as if they were the whole "
+         "sequence: one recording standing in for several sessions")
+      ->type_name("A-B")
+      ->check([](const std::string& text) {
+        try {
+          (void)parseFrameRange(text);
+          return std::string();
+        } catch (const std::invalid_argument& e) {
+          return std::string(e.what());
+        }
+      });
   addMapsOption(run, options->maps);
   run->add_option("--map", options->map_name,
                   "Edge map this session writes into (created when new; default: a new map named "

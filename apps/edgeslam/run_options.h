@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 
+#include "io/frame_range.h"
 #include "network_security_options.h"
 #include "pipeline/slam_system.h"
 
@@ -30,9 +31,10 @@ struct RunOptions {
   std::optional<int> segment_refresh_min;  // default: SegmentationRefreshOptions, or the most
   // Lost frames bridged by the motion prediction (TrackerOptions::recover_within_frames).
   std::size_t recover_frames = TrackerOptions{}.recover_within_frames;
-  std::size_t max_frames = 0;  // 0 = all
-  bool realtime = false;       // feed at the dataset's rate (default: as fast as possible)
-  bool fast = false;           // explicit request for the default
+  std::size_t max_frames = 0;        // 0 = all
+  std::optional<FrameRange> frames;  // `--frames A-B`: only these frames of the dataset
+  bool realtime = false;             // feed at the dataset's rate (default: as fast as possible)
+  bool fast = false;                 // explicit request for the default
   std::filesystem::path out_dir;
   std::optional<int> viewer_port;  // serve the web viewer (0 = any free port)
   std::string viewer_host = "127.0.0.1";

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "io/dataset.h"
-#include "synth/frame_range.h"
+#include "io/frame_range.h"
 #include "synth/people_compositor.h"
 #include "synth/people_motion.h"
 #include "synth/person_sprite.h"

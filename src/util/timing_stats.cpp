@@ -31,6 +31,7 @@ PercentileSummary SampleStats::summary() const {
   };
   s.median = at(0.5);
   s.p90 = at(0.9);
+  s.p95 = at(0.95);
   s.p99 = at(0.99);
   s.max = sorted.back();
   s.mean = std::accumulate(sorted.begin(), sorted.end(), 0.0) / static_cast<double>(sorted.size());

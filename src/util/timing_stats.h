@@ -11,6 +11,7 @@ struct PercentileSummary {
   std::size_t count = 0;
   double median = 0.0;
   double p90 = 0.0;
+  double p95 = 0.0;
   double p99 = 0.0;
   double max = 0.0;
   double mean = 0.0;

@@ -131,7 +131,7 @@ async function mobileView(browser) {
 
 async function edgeView(browser) {
   const serverArgs = (viewerPort, listen) => ['server', '--listen', listen, '--viewer', String(viewerPort),
-    '--semantic', 'off', '--vocab', 'none', '--status-every', '0'];
+    '--semantic', 'off', '--vocab', 'none', '--status-every', '0', '--maps', path.join(outDir, 'maps')];
   const server = await start(serverArgs(0, '127.0.0.1:0'), /viewer: (http:\/\/[\d.]+:(\d+)\/)[\s\S]*listening on ([\d.]+:\d+)/, 'server');
   const [, url, viewerPort, address] = server.match;
   const clientArgs = ['client', '--server', address, '--dataset', args.dataset, '--realtime', '--max-frames', '300',

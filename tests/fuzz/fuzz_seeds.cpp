@@ -16,6 +16,7 @@
 #include "net/net_test_records.h"
 #include "net/wire_convert.h"
 #include "place/vocabulary_training.h"
+#include "store/store_fixture.h"
 
 namespace fs = std::filesystem;
 using namespace edgeslam;
@@ -181,5 +182,25 @@ int main(int argc, char** argv) {
   content << in.rdbuf();
   writeSeed("fuzz_vocabulary_file", "k3l2.vocab", content.str());
   fs::remove(vocab);
+
+  // A small store as a server leaves it: one map of three keyframes, written by the store writer.
+  const fs::path store_dir = g_root / "store";
+  fs::remove_all(store_dir);
+  {
+    test::SmallMap small(40);
+    std::shared_ptr<MapStore> store = openMapStore(store_dir, MapStoreAccess::kServe);
+    const StoreSessionId session = store->beginSession("kitchen", small.info());
+    MapStoreWriter writer(store, session, small.map, std::make_shared<MapStoreWriteStats>());
+    {
+      std::lock_guard lock(small.map.updateMutex());
+      writer.onMapChanged(small.map.takeChanges());
+    }
+    writer.stop();
+  }
+  std::ifstream store_file(store_dir / "maps.sqlite", std::ios::binary);
+  std::ostringstream store_bytes;
+  store_bytes << store_file.rdbuf();
+  writeSeed("fuzz_map_store", "small.sqlite", store_bytes.str());
+  fs::remove_all(store_dir);
   return 0;
 }

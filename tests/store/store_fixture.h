@@ -21,11 +21,11 @@ inline std::filesystem::path freshStoreDir(const std::string& name) {
 }
 
 struct SmallMap {
-  SyntheticScene scene{400, 3};
+  SyntheticScene scene;
   Map map;
   std::vector<KeyFrame*> keyframes;
 
-  SmallMap() {
+  explicit SmallMap(int scene_points = 400) : scene(scene_points, 3) {
     for (int i = 0; i < 3; ++i) {
       const auto view = scene.view(poseAt({0.15 * i, 0.02 * i, 0}, 0.03 * i), 0, true);
       KeyFrame* kf = scene.addKeyFrame(map, view, static_cast<std::size_t>(10 * i), i == 0);

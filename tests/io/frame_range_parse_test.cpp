@@ -1,8 +1,8 @@
-#include "synth/frame_range.h"
-
 #include <gtest/gtest.h>
 
 #include <stdexcept>
+
+#include "io/frame_range.h"
 
 namespace edgeslam {
 namespace {
