@@ -171,6 +171,8 @@ class SlamSystem {
   virtual std::size_t trackingRecoveries() const { return 0; }
   // Keyframes the client's tracker made, by rule (zeros where the client does not track).
   virtual KeyFrameDecisionCounts keyFrameDecisions() const { return {}; }
+  // Why frames had no map or were lost, per cause (nullopt where the client does not track).
+  virtual std::optional<TrackingDiagnostics> trackingDiagnostics() const { return std::nullopt; }
   virtual std::size_t mapResets() const = 0;
   // The last frame's semantic stage (mask, culled features); nullptr where the client does not
   // track (offload).
@@ -197,6 +199,9 @@ class TrackingSlam : public SlamSystem {
   std::size_t trackingRecoveries() const override { return tracker_->recoveries(); }
   KeyFrameDecisionCounts keyFrameDecisions() const override {
     return tracker_->keyFrameDecisions();
+  }
+  std::optional<TrackingDiagnostics> trackingDiagnostics() const override {
+    return tracker_->diagnostics();
   }
   std::size_t mapResets() const override { return tracker_->resets(); }
   // Always present: without semantic culling, every feature is kept and there is no mask.
