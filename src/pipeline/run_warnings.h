@@ -21,7 +21,7 @@ struct RunHealth {
   std::size_t frames_out_of_order = 0;  // skipped: timestamp repeated or going back
   std::size_t frames_without_map = 0;   // processed before the first map (or after a reset)
   bool map_built = true;
-  std::string refusals;  // initialisation refusals by cause, most frequent first ("" = none)
+  std::string refusals = {};  // initialisation refusals by cause, most frequent first ("" = none)
 };
 
 struct RunWarningThresholds {

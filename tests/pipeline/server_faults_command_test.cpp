@@ -151,7 +151,10 @@ TEST_F(ServerFaults, ClientKilledMidUploadIsClosedAndCountedWhileOthersRunOn) {
   // The victim's session is closed once silent for the idle timeout (3 s), and what it had
   // received and never got back is counted.
   const auto m = waitForServerMetrics(
-      [](const nlohmann::json& j) { return j["closed_sessions"]["idle"].get<int>() >= 1; }, 30s);
+      [](const nlohmann::json& j) {
+        return j["closed_sessions"]["sessions"].get<int>() >= 2 && j["sessions_open"] == 0;
+      },
+      30s);
   ASSERT_FALSE(m.empty()) << server_->log();
   const auto& closed = m["closed_sessions"];
   EXPECT_EQ(closed["idle"], 1) << m.dump(2);
@@ -172,7 +175,8 @@ TEST_F(ServerFaults, FrozenClientNeitherBlocksOthersNorTheServerStopping) {
   auto healthy = startClient("healthy", 120);
   expectHealthyClient(*healthy, "healthy", 120);
   // An open stream keeps the frozen session (it may wake up); the server must still stop.
-  const auto m = serverMetrics();
+  const auto m = waitForServerMetrics(
+      [](const nlohmann::json& j) { return j["closed_sessions"]["by_client"] == 1; }, 10s);
   EXPECT_EQ(m["sessions_open"], 1) << m.dump(2);
   expectServerStopsCleanly();
   frozen->signal(SIGKILL);
@@ -200,7 +204,10 @@ TEST_F(ServerFaults, LinkStallLongerThanEveryDeadlineIsSurvivedAndCounted) {
   ASSERT_EQ(*code, 0) << stalled->log();
   const auto m = readJson(folder_ / "stalled" / "metrics.json");
   ASSERT_FALSE(m.empty());
-  EXPECT_GT(m["tracked"].get<int>(), 200) << m.dump(2);
+  // Without slices and with its uploads backed up, the client loses track for a while; it
+  // must come back (half the frames tracked) and count the losses.
+  EXPECT_GE(m["tracked"].get<int>(), 150) << m.dump(2);
+  EXPECT_EQ(m["lost"], m["lost_frames"]["tracking_failed"]) << m.dump(2);
   // What the stall cost is counted: slices that never came back, uploads dropped or streams
   // re-established.
   const int lost = m["uploads_dropped"].get<int>() + m["reconnects"].get<int>() +
