@@ -216,5 +216,39 @@ TEST_F(ServerFaults, LinkStallLongerThanEveryDeadlineIsSurvivedAndCounted) {
   expectServerStopsCleanly();
 }
 
+TEST_F(ServerFaults, ClientThatNeverReadsItsSlicesEndsAndTheServerCountsThem) {
+  // After 3 s (the connection and the session opened) the downlink delays everything by 10
+  // minutes: the client uploads, but no slice reaches it during its run. Unpaced (--fast), the
+  // client waits for its back end before each keyframe; the wait must give up rather than hang.
+  std::ofstream(folder_ / "deaf.trace") << "0 0 0 1 1\n3 0 0 1 600000\n1000 0 0 1 600000\n";
+  const int link_port = freePort();
+  const std::string link_address = "127.0.0.1:" + std::to_string(link_port);
+  test::ChildProcess link(test::edgeslamBinary(),
+                          {"linkem", "--listen", link_address, "--target", address(), "--trace",
+                           (folder_ / "deaf.trace").string()},
+                          folder_ / "linkem.log");
+  ASSERT_TRUE(link.waitForLog("127.0.0.1", 10s)) << link.log();
+  auto deaf = startClient("deaf", 90, "", link_address);
+  const auto code = deaf->wait(180s);
+  ASSERT_TRUE(code.has_value()) << "the client hung\n" << deaf->log();
+  ASSERT_EQ(*code, 0) << deaf->log();
+  const auto client = readJson(folder_ / "deaf" / "metrics.json");
+  ASSERT_FALSE(client.empty());
+  // Only the slices of the first 3 s arrived.
+  EXPECT_LT(client["slices_applied"].get<int>(), client["keyframes_uploaded"].get<int>())
+      << client.dump(2);
+  // The server closed the session (the client's close got through the uplink) and counts the
+  // slices it made that were never acknowledged.
+  const auto m = waitForServerMetrics(
+      [](const nlohmann::json& j) { return j["closed_sessions"]["sessions"].get<int>() >= 1; },
+      20s);
+  const auto& closed = m["closed_sessions"];
+  EXPECT_GT(closed["keyframes"].get<int>(), client["slices_applied"].get<int>()) << m.dump(2);
+  EXPECT_LE(closed["keyframes"].get<int>(), client["keyframes_uploaded"].get<int>()) << m.dump(2);
+  EXPECT_GT(closed["slices_unacknowledged"].get<int>(), 0) << m.dump(2);
+  EXPECT_NE(server_->log().find("slices never acknowledged"), std::string::npos) << server_->log();
+  expectServerStopsCleanly();
+}
+
 }  // namespace
 }  // namespace edgeslam
