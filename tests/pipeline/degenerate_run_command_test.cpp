@@ -13,6 +13,7 @@
 #include "io/dataset.h"
 #include "io/temp_folder.h"
 #include "support/edgeslam_command.h"
+#include "support/image_folder_sequence.h"
 #include "support/shared_data.h"
 #include "synth/degenerate_frames.h"
 
@@ -21,17 +22,6 @@ namespace {
 
 namespace fs = std::filesystem;
 constexpr const char* kKitchen = "datasets/7scenes-redkitchen-1000";
-
-void writeCamera(const fs::path& folder) {
-  std::ofstream(folder / "camera.yaml")
-      << "width: 640\nheight: 480\nfx: 585\nfy: 585\ncx: 320\ncy: 240\nfps: 30\n";
-}
-
-std::string frameName(std::size_t i) {
-  char name[32];
-  std::snprintf(name, sizeof(name), "frame_%04zu.png", i);
-  return name;
-}
 
 nlohmann::json run(const fs::path& dataset, const fs::path& out, const std::string& mode) {
   const auto r = test::runEdgeslam("run --dataset " + dataset.string() +
@@ -47,10 +37,10 @@ TEST(DegenerateRun, StillCameraBuildsNoMapAndMetricsSayLowParallax) {
   EDGESLAM_REQUIRE_SHARED(kKitchen);
   test::TempFolder folder;
   const fs::path still = folder / "still";
-  fs::create_directories(still);
-  writeCamera(still);
   const cv::Mat frame = openDataset(test::sharedPath(kKitchen))->load(100).gray;
-  for (std::size_t i = 0; i < 30; ++i) cv::imwrite((still / frameName(i)).string(), frame);
+  std::vector<test::StampedImage> frames;
+  for (std::size_t i = 0; i < 30; ++i) frames.push_back({frame, static_cast<double>(i) / 30.0});
+  test::writeImageFolder(still, frames);
 
   const auto m = run(still, folder / "out", "edge");
   ASSERT_FALSE(m.empty());
@@ -72,28 +62,7 @@ TEST(DegenerateRun, BlankStretchAndDisorderedFramesAreCountedNotTracked) {
   EDGESLAM_REQUIRE_SHARED(kKitchen);
   test::TempFolder folder;
   const fs::path walk = folder / "walk";
-  fs::create_directories(walk);
-  writeCamera(walk);
-  const auto reader = openDataset(test::sharedPath(kKitchen));
-  // Frames 0-139 of the walk; 90-99 overexposed to white; one frame repeated with its timestamp
-  // (a duplicated frame) and one stamped before its predecessor (out of order).
-  std::ofstream times(walk / "times.txt");
-  std::size_t out_index = 0;
-  for (std::size_t i = 0; i < 140; ++i) {
-    const cv::Mat gray = reader->load(i).gray;
-    const cv::Mat image = i >= 90 && i < 100 ? overexposed(gray, 8.0) : gray;
-    cv::imwrite((walk / frameName(out_index++)).string(), image);
-    times << static_cast<double>(i) / 30.0 << "\n";
-    if (i == 40) {
-      cv::imwrite((walk / frameName(out_index++)).string(), image);
-      times << static_cast<double>(i) / 30.0 << "\n";
-    }
-    if (i == 120) {
-      cv::imwrite((walk / frameName(out_index++)).string(), reader->load(115).gray);
-      times << 115.0 / 30.0 << "\n";
-    }
-  }
-  times.close();
+  test::writeImageFolder(walk, test::walkWithDisorder(*openDataset(test::sharedPath(kKitchen))));
 
   const auto m = run(walk, folder / "out", "local");
   ASSERT_FALSE(m.empty());

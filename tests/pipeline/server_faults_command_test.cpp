@@ -15,6 +15,7 @@
 
 #include "io/temp_folder.h"
 #include "support/child_process.h"
+#include "support/image_folder_sequence.h"
 #include "support/shared_data.h"
 
 namespace edgeslam {
@@ -247,6 +248,34 @@ TEST_F(ServerFaults, ClientThatNeverReadsItsSlicesEndsAndTheServerCountsThem) {
   EXPECT_LE(closed["keyframes"].get<int>(), client["keyframes_uploaded"].get<int>()) << m.dump(2);
   EXPECT_GT(closed["slices_unacknowledged"].get<int>(), 0) << m.dump(2);
   EXPECT_NE(server_->log().find("slices never acknowledged"), std::string::npos) << server_->log();
+  expectServerStopsCleanly();
+}
+
+TEST_F(ServerFaults, DuplicatedAndOutOfOrderFramesAreSkippedAndCounted) {
+  // A camera that delivers a frame twice and a stale frame late, and blanks out for 10 frames:
+  // the client skips the disordered frames before tracking (so the edge never sees them) and
+  // counts them; the white frames are lost and counted as such.
+  test::writeImageFolder(folder_ / "walk",
+                         test::walkWithDisorder(*openDataset(test::sharedPath(kKitchen))));
+  test::ChildProcess client(
+      test::edgeslamBinary(),
+      {"client", "--server", address(), "--dataset", (folder_ / "walk").string(), "--sensor",
+       "mono", "--vocab", "none", "--out", (folder_ / "walk-out").string()},
+      folder_ / "walk.log");
+  const auto code = client.wait(240s);
+  ASSERT_TRUE(code.has_value()) << client.log();
+  ASSERT_EQ(*code, 0) << client.log();
+  const auto m = readJson(folder_ / "walk-out" / "metrics.json");
+  ASSERT_FALSE(m.empty());
+  EXPECT_EQ(m["frames_out_of_order"]["skipped"], 2) << m.dump(2);
+  EXPECT_EQ(m["lost_frames"]["too_few_features"], 10) << m.dump(2);
+  EXPECT_EQ(m["uploads_dropped"], 0);
+  EXPECT_EQ(m["slices_applied"], m["keyframes_uploaded"]);
+  const auto server = waitForServerMetrics(
+      [](const nlohmann::json& j) { return j["closed_sessions"]["by_client"] == 1; }, 10s);
+  EXPECT_EQ(server["closed_sessions"]["keyframes"], m["keyframes_uploaded"]) << server.dump(2);
+  EXPECT_EQ(server["closed_sessions"]["missing_uploads"], 0) << server.dump(2);
+  EXPECT_EQ(server["closed_sessions"]["duplicate_uploads"], 0) << server.dump(2);
   expectServerStopsCleanly();
 }
 
