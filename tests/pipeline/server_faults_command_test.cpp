@@ -9,7 +9,9 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <nlohmann/json.hpp>
+#include <sstream>
 #include <string>
 #include <thread>
 
@@ -38,6 +40,17 @@ int freePort() {
   ::getsockname(fd, reinterpret_cast<sockaddr*>(&address), &length);
   ::close(fd);
   return ntohs(address.sin_port);
+}
+
+// One line of a client's figures in the test's output.
+void printClient(const std::string& name, const nlohmann::json& m) {
+  std::cout << name << ": frames " << m["frames"] << ", tracked " << m["tracked"] << ", lost "
+            << m["lost"] << ", keyframes uploaded " << m["keyframes_uploaded"]
+            << ", slices applied " << m["slices_applied"] << ", uploads dropped "
+            << m["uploads_dropped"] << ", reconnects " << m["reconnects"] << ", wall "
+            << m["wall_s"] << " s, ATE "
+            << (m.contains("ate") && m["ate"].is_object() ? m["ate"]["rmse_m"].dump() : "-")
+            << " m\n";
 }
 
 nlohmann::json readJson(const fs::path& file) {
@@ -102,6 +115,7 @@ class ServerFaults : public ::testing::Test {
     ASSERT_EQ(*code, 0) << client.log();
     const auto m = readJson(folder_ / name / "metrics.json");
     ASSERT_FALSE(m.empty()) << client.log();
+    printClient(name, m);
     EXPECT_EQ(m["tracked"], frames);
     EXPECT_EQ(m["uploads_dropped"], 0);
     EXPECT_EQ(m["slices_applied"], m["keyframes_uploaded"]);
@@ -126,9 +140,21 @@ class ServerFaults : public ::testing::Test {
   // The server is alive, small, and stops promptly and cleanly when asked.
   void expectServerStopsCleanly() {
     ASSERT_TRUE(server_->running()) << server_->log();
-    EXPECT_LT(server_->residentBytes(), kMaxServerRss);
+    const std::size_t rss = server_->residentBytes();
+    EXPECT_LT(rss, kMaxServerRss);
+    // The figures, for whoever reads the test's output.
+    std::cout << "server RSS " << rss / (1u << 20) << " MB; metrics "
+              << serverMetrics()["closed_sessions"].dump() << "\n";
+    std::istringstream log(server_->log());
+    for (std::string line; std::getline(log, line);) {
+      if (line.find("closed") != std::string::npos) std::cout << "server log: " << line << "\n";
+    }
     server_->signal(SIGTERM);
+    const auto asked = std::chrono::steady_clock::now();
     const auto code = server_->wait(10s);
+    std::cout << "server stopped in "
+              << std::chrono::duration<double>(std::chrono::steady_clock::now() - asked).count()
+              << " s\n";
     ASSERT_TRUE(code.has_value()) << "server did not stop within 10 s\n" << server_->log();
     EXPECT_EQ(*code, 0) << server_->log();
   }
@@ -205,6 +231,7 @@ TEST_F(ServerFaults, LinkStallLongerThanEveryDeadlineIsSurvivedAndCounted) {
   ASSERT_EQ(*code, 0) << stalled->log();
   const auto m = readJson(folder_ / "stalled" / "metrics.json");
   ASSERT_FALSE(m.empty());
+  printClient("stalled", m);
   // Without slices and with its uploads backed up, the client loses track for a while; it
   // must come back (half the frames tracked) and count the losses.
   EXPECT_GE(m["tracked"].get<int>(), 150) << m.dump(2);
@@ -235,6 +262,7 @@ TEST_F(ServerFaults, ClientThatNeverReadsItsSlicesEndsAndTheServerCountsThem) {
   ASSERT_EQ(*code, 0) << deaf->log();
   const auto client = readJson(folder_ / "deaf" / "metrics.json");
   ASSERT_FALSE(client.empty());
+  printClient("deaf", client);
   // Only the slices of the first 3 s arrived.
   EXPECT_LT(client["slices_applied"].get<int>(), client["keyframes_uploaded"].get<int>())
       << client.dump(2);
@@ -267,6 +295,7 @@ TEST_F(ServerFaults, DuplicatedAndOutOfOrderFramesAreSkippedAndCounted) {
   ASSERT_EQ(*code, 0) << client.log();
   const auto m = readJson(folder_ / "walk-out" / "metrics.json");
   ASSERT_FALSE(m.empty());
+  printClient("walk", m);
   EXPECT_EQ(m["frames_out_of_order"]["skipped"], 2) << m.dump(2);
   EXPECT_EQ(m["lost_frames"]["too_few_features"], 10) << m.dump(2);
   EXPECT_EQ(m["uploads_dropped"], 0);
