@@ -424,6 +424,7 @@ int runPipeline(const RunOptions& given) {
                             {"keyframes_uploaded", counters.keyframes_uploaded},
                             {"uploads_dropped", counters.uploads_dropped},
                             {"uploads_overflowed", counters.uploads_overflowed},
+                            {"uploads_unanswered", counters.uploads_unanswered},
                             {"keyframes_forgotten", counters.keyframes_forgotten},
                             {"points_forgotten", counters.points_forgotten},
                             {"slices_applied", counters.slices_applied},

@@ -94,8 +94,10 @@ struct ClosedSessionTotals {
   std::uint64_t duplicate_uploads = 0;
   std::uint64_t missing_uploads = 0;
   std::uint64_t slices_pushed = 0;
-  std::uint64_t slices_dropped = 0;         // dropped unacknowledged while the session ran
-  std::uint64_t slices_unacknowledged = 0;  // made but never acknowledged by the client
+  std::uint64_t slices_dropped = 0;  // dropped unacknowledged while the session ran
+  // Made but never acknowledged by the client; a clean close leaves its last slice here too
+  // (applied, but acknowledgements ride on uploads and none followed).
+  std::uint64_t slices_unacknowledged = 0;
 };
 
 class EdgeServer {

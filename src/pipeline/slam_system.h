@@ -94,7 +94,10 @@ struct SlamCounters {
   std::uint64_t downlink_bytes = 0;
   std::uint64_t keyframes_uploaded = 0;
   std::uint64_t uploads_dropped = 0;
-  std::uint64_t uploads_overflowed = 0;   // of those, pushed out of the link's full queue
+  std::uint64_t uploads_overflowed = 0;  // of those, pushed out of the link's full queue
+  // Sent, neither answered by a slice nor dropped when the run ended (a stalled link, a lost
+  // edge): the edge may or may not have them.
+  std::uint64_t uploads_unanswered = 0;
   std::uint64_t keyframes_forgotten = 0;  // by the client, their upload dropped
   std::uint64_t points_forgotten = 0;     // that went up with those uploads only
   std::uint64_t slices_applied = 0;

@@ -47,8 +47,8 @@ void printClient(const std::string& name, const nlohmann::json& m) {
   std::cout << name << ": frames " << m["frames"] << ", tracked " << m["tracked"] << ", lost "
             << m["lost"] << ", keyframes uploaded " << m["keyframes_uploaded"]
             << ", slices applied " << m["slices_applied"] << ", uploads dropped "
-            << m["uploads_dropped"] << ", reconnects " << m["reconnects"] << ", wall "
-            << m["wall_s"] << " s, ATE "
+            << m["uploads_dropped"] << ", unanswered " << m["uploads_unanswered"] << ", reconnects "
+            << m["reconnects"] << ", wall " << m["wall_s"] << " s, ATE "
             << (m.contains("ate") && m["ate"].is_object() ? m["ate"]["rmse_m"].dump() : "-")
             << " m\n";
 }
@@ -266,14 +266,22 @@ TEST_F(ServerFaults, ClientThatNeverReadsItsSlicesEndsAndTheServerCountsThem) {
   // Only the slices of the first 3 s arrived.
   EXPECT_LT(client["slices_applied"].get<int>(), client["keyframes_uploaded"].get<int>())
       << client.dump(2);
-  // The server closed the session (the client's close got through the uplink) and counts the
-  // slices it made that were never acknowledged.
+  // The server closes the session (by the client's close, or once silent: the client's new
+  // connections cannot complete over the stalled downlink) and counts the slices it made that
+  // were never acknowledged.
   const auto m = waitForServerMetrics(
       [](const nlohmann::json& j) { return j["closed_sessions"]["sessions"].get<int>() >= 1; },
       20s);
   const auto& closed = m["closed_sessions"];
   EXPECT_GT(closed["keyframes"].get<int>(), client["slices_applied"].get<int>()) << m.dump(2);
+  // Every upload is accounted for: the edge has it, or the client counts it dropped or
+  // unanswered.
   EXPECT_LE(closed["keyframes"].get<int>(), client["keyframes_uploaded"].get<int>()) << m.dump(2);
+  EXPECT_GE(closed["keyframes"].get<int>() + client["uploads_dropped"].get<int>() +
+                client["uploads_unanswered"].get<int>(),
+            client["keyframes_uploaded"].get<int>())
+      << client.dump(2);
+  EXPECT_GT(client["uploads_unanswered"].get<int>(), 0) << client.dump(2);
   EXPECT_GT(closed["slices_unacknowledged"].get<int>(), 0) << m.dump(2);
   EXPECT_NE(server_->log().find("slices never acknowledged"), std::string::npos) << server_->log();
   expectServerStopsCleanly();
