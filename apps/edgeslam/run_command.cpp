@@ -16,6 +16,7 @@
 #include "intrinsics_report.h"
 #include "io/camera_file.h"
 #include "io/dataset.h"
+#include "io/frame_order_guard.h"
 #include "io/frame_prefetcher.h"
 #include "io/frame_range.h"
 #include "io/trajectory.h"
@@ -34,6 +35,7 @@
 #include "segmenter_option.h"
 #include "semantic_evaluation.h"
 #include "store/store_location.h"
+#include "tracking_diagnostics_json.h"
 #include "util/timing_stats.h"
 #include "vocabulary_option.h"
 
@@ -291,6 +293,7 @@ int runPipeline(const RunOptions& given) {
   Stopwatch wall;
   Trajectory ground_truth;
   std::size_t tracked = 0, lost = 0, frames_dropped_late = 0;
+  FrameOrderGuard frame_order;
   std::optional<SemanticEvaluation> semantic_eval = SemanticEvaluation::open(info.path);
   if (semantic_eval) spdlog::info("ground-truth masks found: scoring the semantic culling");
   const auto& stamps = reader->timestamps();
@@ -315,6 +318,10 @@ int runPipeline(const RunOptions& given) {
       const double wait_ms = due_ms - wall.elapsedMs();
       if (wait_ms > 0)
         std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(wait_ms));
+    }
+    if (const auto rejection = frame_order.check(frame.timestamp)) {
+      spdlog::warn("frame {} skipped: {} (t = {:.6f} s)", i, toString(*rejection), frame.timestamp);
+      continue;
     }
     if (frame.ground_truth) ground_truth.push_back({frame.timestamp, *frame.ground_truth});
     // Like a camera driver that keeps the newest frame: once the next frame is due and delivered,
@@ -400,6 +407,7 @@ int runPipeline(const RunOptions& given) {
   const auto ate_final = ateJson(ground_truth, final_traj, align);
 
   const SlamCounters counters = slam.counters();
+  const std::optional<TrackingDiagnostics> diagnostics = slam.trackingDiagnostics();
   const std::vector<std::string> warnings =
       runWarnings({.frames = frame_count,
                    .tracked = tracked,
@@ -409,7 +417,11 @@ int runPipeline(const RunOptions& given) {
                    .backend_wait_ms = counters.backend.wait_total_ms,
                    .wall_ms = seconds * 1000.0,
                    .monocular = sensor == Sensor::kMonocular,
-                   .keyframe_depth_ratio = counters.keyframe_depth_ratio});
+                   .keyframe_depth_ratio = counters.keyframe_depth_ratio,
+                   .frames_out_of_order = frame_order.rejected(),
+                   .frames_without_map = diagnostics ? diagnostics->frames_without_map : 0,
+                   .map_built = !diagnostics || diagnostics->initialized_at_frame.has_value(),
+                   .refusals = diagnostics ? refusalSummary(*diagnostics) : std::string()});
   const std::size_t keyframes_uploaded = std::max<std::size_t>(1, counters.keyframes_uploaded);
   nlohmann::json metrics = {{"frames", frame_count},
                             {"tracked", tracked},
@@ -424,6 +436,7 @@ int runPipeline(const RunOptions& given) {
                             {"keyframes_uploaded", counters.keyframes_uploaded},
                             {"uploads_dropped", counters.uploads_dropped},
                             {"uploads_overflowed", counters.uploads_overflowed},
+                            {"uploads_unanswered", counters.uploads_unanswered},
                             {"keyframes_forgotten", counters.keyframes_forgotten},
                             {"points_forgotten", counters.points_forgotten},
                             {"slices_applied", counters.slices_applied},
@@ -444,6 +457,11 @@ int runPipeline(const RunOptions& given) {
                             {"wall_s", seconds},
                             {"pacing", options.realtime ? "realtime" : "fast"},
                             {"frames_dropped_late", frames_dropped_late},
+                            {"frames_out_of_order",
+                             {{"skipped", frame_order.rejected()},
+                              {"duplicate_timestamp", frame_order.duplicates()},
+                              {"timestamp_backwards", frame_order.backwards()},
+                              {"timestamp_not_finite", frame_order.notFinite()}}},
                             {"backend_waits", counters.backend.waits},
                             {"backend_wait_ms",
                              {{"total", counters.backend.wait_total_ms},
@@ -456,6 +474,10 @@ int runPipeline(const RunOptions& given) {
                             {"keyframe_depth_ratio", counters.keyframe_depth_ratio},
                             {"warnings", warnings},
                             {"load_ms", toJson(load_ms.summary())}};
+  if (diagnostics) {
+    metrics["initialization"] = initializationJson(*diagnostics);
+    metrics["lost_frames"] = lostFramesJson(*diagnostics);
+  }
   if (counters.features_ms.count > 0) {
     metrics["client_stages_ms"] = {{"features", toJson(counters.features_ms)},
                                    {"tracking", toJson(counters.tracking_ms)},
@@ -530,6 +552,16 @@ int runPipeline(const RunOptions& given) {
       "  map          {} keyframes, {} points, {} relocalisations, {} recoveries, {} resets\n",
       slam.keyFrameCount(), slam.mapPointCount(), slam.relocalizations(), slam.trackingRecoveries(),
       slam.mapResets());
+  if (diagnostics && diagnostics->refusals != decltype(diagnostics->refusals){}) {
+    const std::string refused = refusalSummary(*diagnostics);
+    if (diagnostics->initialized_at_frame) {
+      fmt::print("  map start    frame {}, {} frames without a map (refused: {})\n",
+                 *diagnostics->initialized_at_frame, diagnostics->frames_without_map, refused);
+    } else {
+      fmt::print("  map start    none (refused: {}; last: {})\n", refused,
+                 diagnostics->last_refusal);
+    }
+  }
   if (const auto* edge_slam = dynamic_cast<const EdgeSlam*>(&slam)) {
     const ClientMapSize c = edge_slam->clientMapSize();
     fmt::print("  client map   {} keyframes, {} points held (at most {} / {}; window {})\n",

@@ -14,6 +14,7 @@
 #include "network_security_options.h"
 #include "pipeline/slam_session_backend.h"
 #include "segmenter_option.h"
+#include "server_metrics.h"
 #include "server_viewer.h"
 #include "vocabulary_option.h"
 
@@ -37,6 +38,8 @@ struct ServerOptions {
   ServerSecurityOptions security;
   std::optional<int> viewer_port;
   std::string viewer_host = "127.0.0.1";
+  int idle_timeout_s = 60;
+  std::filesystem::path metrics;
 };
 
 int runServer(const ServerOptions& o) {
@@ -72,7 +75,20 @@ int runServer(const ServerOptions& o) {
   const int status_interval_s = o.status_interval_s;
   std::shared_ptr<EdgeSessionFactory> factory = std::make_shared<SlamSessionFactory>(options);
   if (viewer) factory = viewer->wrap(std::move(factory));
-  EdgeServer server(listen, std::move(factory), serverLimits(o.security), std::move(security));
+  EdgeServerLimits limits = serverLimits(o.security);
+  limits.idle_timeout = std::chrono::seconds(o.idle_timeout_s);
+  EdgeServer server(listen, std::move(factory), limits, std::move(security));
+  const auto started = std::chrono::steady_clock::now();
+  const auto write_metrics = [&] {
+    if (o.metrics.empty()) return;
+    const double uptime_s =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    try {
+      writeServerMetrics(o.metrics, serverMetricsJson(server, uptime_s));
+    } catch (const std::exception& e) {
+      spdlog::warn("server metrics: {}", e.what());
+    }
+  };
   const auto viewer_attachment = viewer ? viewer->attach(server) : nullptr;
   spdlog::info("edge server listening on {} (Ctrl-C to stop)", server.address());
   std::signal(SIGINT, requestStop);
@@ -88,10 +104,19 @@ int runServer(const ServerOptions& o) {
                      s.session_id, s.client_name, s.keyframes, s.frames, s.slices_sent,
                      s.uplink_bytes, s.downlink_bytes);
       }
+      write_metrics();
     }
   }
   spdlog::info("stopping: {} session(s) open", server.sessionCount());
   server.shutdown();
+  const ClosedSessionTotals closed = server.closedSessions();
+  spdlog::info(
+      "closed sessions: {} ({} by their client, {} idle, {} reclaimed, {} at shutdown); {} "
+      "keyframes received, {} uploads missing; {} of {} slices never acknowledged",
+      closed.sessions, closed.closed_by_client, closed.closed_idle, closed.closed_reclaimed,
+      closed.closed_at_shutdown, closed.keyframes, closed.missing_uploads,
+      closed.slices_unacknowledged, closed.slices_pushed);
+  write_metrics();
   return 0;
 }
 
@@ -117,6 +142,14 @@ void addServerCommand(CLI::App& app) {
   cmd->add_option("--models", o->models_dir,
                   "Segmentation models folder (default: the shared models)");
   addMapsOption(cmd, o->maps);
+  cmd->add_option("--idle-timeout", o->idle_timeout_s,
+                  "Seconds without a request or an open slice stream after which a session is "
+                  "closed (its client vanished)")
+      ->check(CLI::Range(1, 86400))
+      ->capture_default_str();
+  cmd->add_option("--metrics", o->metrics,
+                  "Write the server's metrics (sessions, what closed sessions lost, RSS) as JSON "
+                  "to this file at every status line and at stop");
   addServerSecurityOptions(*cmd, o->security);
   cmd->add_option("--viewer", o->viewer_port,
                   "Serve the edge view (every session's map and figures) on this port (0 = any "

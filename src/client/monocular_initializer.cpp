@@ -16,14 +16,22 @@ void MonocularInitializer::resetReference(const Frame& frame) {
   if (frame.size() >= static_cast<std::size_t>(options_.min_features)) reference_ = frame;
 }
 
+void MonocularInitializer::refuse(InitRefusal refusal, std::string why) {
+  last_refusal_ = refusal;
+  last_failure_ = std::move(why);
+}
+
 KeyFrame* MonocularInitializer::tryInitialize(Frame& frame, Map& map) {
+  last_refusal_.reset();
+  // A featureless frame (blank, overexposed) neither serves as a reference nor initialises.
+  if (frame.size() < static_cast<std::size_t>(options_.min_features)) {
+    refuse(InitRefusal::kTooFewFeatures,
+           fmt::format("{} features, need {}", frame.size(), options_.min_features));
+    return nullptr;
+  }
   if (!reference_ || frame.index - reference_->index > options_.max_reference_age) {
     resetReference(frame);
     last_failure_ = "waiting for a second frame";
-    return nullptr;
-  }
-  if (frame.size() < static_cast<std::size_t>(options_.min_features)) {
-    last_failure_ = "too few features";
     return nullptr;
   }
   const FrameFeatures& ref = *reference_->features;
@@ -35,7 +43,8 @@ KeyFrame* MonocularInitializer::tryInitialize(Frame& frame, Map& map) {
       matchInWindow(ref.keypoints, ref.descriptors, cur.keypoints, cur.descriptors, cur.grid,
                     options_.search_radius, match_options, 0);
   if (matches.size() < static_cast<std::size_t>(options_.min_matches)) {
-    last_failure_ = fmt::format("{} matches to the reference frame", matches.size());
+    refuse(InitRefusal::kTooFewMatches, fmt::format("{} matches to the reference frame, need {}",
+                                                    matches.size(), options_.min_matches));
     resetReference(frame);
     return nullptr;
   }
@@ -52,7 +61,7 @@ KeyFrame* MonocularInitializer::tryInitialize(Frame& frame, Map& map) {
   ++attempts_;
   TwoViewResult two_view = initializeTwoView(ref_px, cur_px, camera_.K(), options_.two_view);
   if (!two_view.success) {
-    last_failure_ = two_view.reason;
+    refuse(refusalFor(two_view.failure), two_view.reason);
     return nullptr;
   }
 
@@ -81,8 +90,9 @@ KeyFrame* MonocularInitializer::tryInitialize(Frame& frame, Map& map) {
   const double median_depth = kf0->medianSceneDepth();
   const int tracked = kf1->trackedPointCount(1);
   if (median_depth <= 0.0 || tracked < options_.min_map_points) {
-    last_failure_ =
-        fmt::format("initial map too weak ({} points, median depth {:.3f})", tracked, median_depth);
+    refuse(InitRefusal::kWeakMap,
+           fmt::format("initial map too weak ({} points, median depth {:.3f})", tracked,
+                       median_depth));
     map.clear();
     resetReference(frame);
     return nullptr;

@@ -5,6 +5,7 @@
 #include <memory>
 #include <optional>
 
+#include "client/tracking_diagnostics.h"
 #include "geometry/camera.h"
 #include "geometry/two_view_initializer.h"
 #include "map/frame.h"
@@ -35,6 +36,8 @@ class MonocularInitializer {
   // pose and point matches set. Returns the second keyframe (the current frame's) or nullptr.
   KeyFrame* tryInitialize(Frame& frame, Map& map);
   const std::string& lastFailure() const { return last_failure_; }
+  // Why the last call built no map; nullopt when it only waited (a new reference frame).
+  std::optional<InitRefusal> lastRefusal() const { return last_refusal_; }
   int attempts() const { return attempts_; }
 
  private:
@@ -43,7 +46,10 @@ class MonocularInitializer {
   const PinholeCamera& camera_;
   MonocularInitializerOptions options_;
   std::optional<Frame> reference_;
+  void refuse(InitRefusal refusal, std::string why);
+
   std::string last_failure_;
+  std::optional<InitRefusal> last_refusal_;
   int attempts_ = 0;
 };
 

@@ -1,5 +1,6 @@
 #include "client/tracker.h"
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -65,7 +66,10 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
   TrackResult result;
 
   if (state_ == TrackingState::kNotInitialized) {
+    ++diagnostics_.frames_without_map;
     if (initialize(frame)) {
+      if (!diagnostics_.initialized_at_frame) diagnostics_.initialized_at_frame = frame_index;
+      ++diagnostics_.initializations;
       state_ = TrackingState::kOk;
       result.new_keyframe = true;
       if (reference_keyframe_ != nullptr) result.keyframe = reference_keyframe_->id();
@@ -146,6 +150,9 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
       result.tracked_points = inliers;
     } else {
       if (state_ == TrackingState::kOk) spdlog::warn("tracking lost at frame {}", frame_index);
+      diagnostics_.lose(frame.size() < options_.min_trackable_features
+                            ? LostCause::kTooFewFeatures
+                            : LostCause::kTrackingFailed);
       state_ = TrackingState::kLost;
       ++frames_lost_;
       if (!canRecoverByPrediction(frame_index + 1)) velocity_.reset();
@@ -191,6 +198,9 @@ bool Tracker::initialize(Frame& frame) {
   KeyFrame* kf = mono_init_.tryInitialize(frame, map_);
   if (kf == nullptr) {
     spdlog::debug("frame {}: not initialised: {}", frame.index, mono_init_.lastFailure());
+    if (const auto refusal = mono_init_.lastRefusal()) {
+      diagnostics_.refuse(*refusal, mono_init_.lastFailure());
+    }
     return false;
   }
   KeyFrame* kf0 = nullptr;
@@ -223,7 +233,12 @@ bool Tracker::initialize(Frame& frame) {
 }
 
 bool Tracker::initializeRgbd(Frame& frame) {
-  if (frame.size() < static_cast<std::size_t>(options_.rgbd_init_min_features)) return false;
+  if (frame.size() < static_cast<std::size_t>(options_.rgbd_init_min_features)) {
+    diagnostics_.refuse(
+        InitRefusal::kTooFewFeatures,
+        fmt::format("{} features, need {}", frame.size(), options_.rgbd_init_min_features));
+    return false;
+  }
   KeyFrame* kf = nullptr;
   {
     std::lock_guard lock(map_.updateMutex());
@@ -240,6 +255,9 @@ bool Tracker::initializeRgbd(Frame& frame) {
       frame.points[i] = p;
     }
     if (map_.pointCount() < 100) {
+      diagnostics_.refuse(
+          InitRefusal::kTooFewDepthPoints,
+          fmt::format("{} keypoints with a valid depth, need 100", map_.pointCount()));
       map_.clear();
       frame.T_cw.reset();
       std::fill(frame.points.begin(), frame.points.end(), nullptr);

@@ -12,6 +12,7 @@
 #include "client/keyframe_places.h"
 #include "client/keyframe_policy.h"
 #include "client/monocular_initializer.h"
+#include "client/tracking_diagnostics.h"
 #include "client/tracking_types.h"
 #include "geometry/camera.h"
 #include "map/frame.h"
@@ -28,6 +29,9 @@ struct TrackerOptions {
   int rgbd_init_min_features = 500;
   // RGB-D: keypoints closer than this (metres) become points at keyframe creation ("close" depth).
   float close_depth_m = 3.2f;
+  // A lost frame with fewer features than this is counted as lost to "too few features" (blank,
+  // overexposed, textureless) rather than to a tracking failure.
+  std::size_t min_trackable_features = 100;
   int min_inliers_motion = 10;
   int min_inliers_local_map = 30;
   int min_inliers_local_map_after_relocalization = 50;
@@ -106,6 +110,8 @@ class Tracker {
   // Keyframes made so far, by the rule that made them.
   const KeyFrameDecisionCounts& keyFrameDecisions() const { return keyframe_decisions_; }
   const KeyFrameTriangulationStats& triangulationStats() const { return triangulation_; }
+  // Why frames had no map or no pose, per cause.
+  const TrackingDiagnostics& diagnostics() const { return diagnostics_; }
 
  private:
   bool initialize(Frame& frame);
@@ -151,6 +157,7 @@ class Tracker {
   std::size_t resets_ = 0;
   std::size_t frames_lost_ = 0;
   KeyFrameTriangulationStats triangulation_;
+  TrackingDiagnostics diagnostics_;
 };
 
 }  // namespace edgeslam

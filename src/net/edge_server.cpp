@@ -132,6 +132,10 @@ std::size_t EdgeServer::sessionCount() const {
   return impl_->registry.size();
 }
 
+ClosedSessionTotals EdgeServer::closedSessions() const {
+  return impl_->registry.closedTotals();
+}
+
 std::uint64_t EdgeServer::idleSessionsClosed() const {
   return impl_->registry.idleClosed();
 }

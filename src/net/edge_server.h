@@ -69,16 +69,35 @@ struct SessionStats {
   std::uint64_t session_id = 0;
   std::uint8_t id_origin = 0;
   std::string client_name;
-  std::uint64_t uplink_bytes = 0;    // serialized request bytes received in this session
-  std::uint64_t downlink_bytes = 0;  // serialized reply and slice bytes sent
-  std::uint64_t keyframes = 0;       // uploads passed on to the backend
-  std::uint64_t duplicate_uploads = 0;
-  std::uint64_t frames = 0;  // offloaded frames
+  std::uint64_t uplink_bytes = 0;       // serialized request bytes received in this session
+  std::uint64_t downlink_bytes = 0;     // serialized reply and slice bytes sent
+  std::uint64_t keyframes = 0;          // uploads passed on to the backend
+  std::uint64_t duplicate_uploads = 0;  // retries, or older than an upload already passed on
+  std::uint64_t missing_uploads = 0;    // sequence gaps: uploads the client dropped or lost
+  std::uint64_t frames = 0;             // offloaded frames
   std::uint64_t slices_pushed = 0;
   std::uint64_t slices_sent = 0;
   std::uint64_t slices_dropped = 0;  // dropped unacknowledged (queue bounds)
   std::uint64_t slices_acknowledged = 0;
   bool streaming = false;
+};
+
+// What the sessions closed so far had received and left undelivered, summed: a client that
+// vanished (killed, link gone) shows up here once the idle reaper closes its session.
+struct ClosedSessionTotals {
+  std::uint64_t sessions = 0;
+  std::uint64_t closed_by_client = 0;
+  std::uint64_t closed_idle = 0;       // the client went silent for the idle timeout
+  std::uint64_t closed_reclaimed = 0;  // unused, closed to make room for a new session
+  std::uint64_t closed_at_shutdown = 0;
+  std::uint64_t keyframes = 0;
+  std::uint64_t duplicate_uploads = 0;
+  std::uint64_t missing_uploads = 0;
+  std::uint64_t slices_pushed = 0;
+  std::uint64_t slices_dropped = 0;  // dropped unacknowledged while the session ran
+  // Made but never acknowledged by the client; a clean close leaves its last slice here too
+  // (applied, but acknowledgements ride on uploads and none followed).
+  std::uint64_t slices_unacknowledged = 0;
 };
 
 class EdgeServer {
@@ -103,6 +122,7 @@ class EdgeServer {
   std::size_t sessionCount() const;
   // Sessions closed because their client went silent.
   std::uint64_t idleSessionsClosed() const;
+  ClosedSessionTotals closedSessions() const;
 
  private:
   struct Impl;

@@ -203,6 +203,10 @@ grpc::Status EdgeService::UploadKeyFrame(grpc::ServerContext* context,
     return grpc::Status::OK;
   }
   if (grpc::Status status = admitUpload(*session); !status.ok()) return status;
+  // Gaps after the session's first upload (a reopened session continues the client's count).
+  if (session->last_upload_sequence != 0) {
+    session->missing_uploads += sequence - session->last_upload_sequence - 1;
+  }
   session->last_upload_sequence = sequence;
   try {
     session->backend->onKeyFrame(std::move(upload));

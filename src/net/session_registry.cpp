@@ -108,6 +108,7 @@ std::shared_ptr<ServerSession> SessionRegistry::open(SessionConfig config,
     spdlog::info("edge server: session {:#x} ('{}') closed, unused for {} ms, to make room",
                  reclaimed->config.session_id, reclaimed->config.client_name,
                  reclaim_idle_after_.count());
+    account(*reclaimed, CloseReason::kReclaimed);
     reclaimed->slices.close();
     reclaimed.reset();
   }
@@ -135,14 +136,16 @@ std::shared_ptr<ServerSession> SessionRegistry::find(std::uint64_t session_id) c
   return it == sessions_.end() ? nullptr : it->second;
 }
 
-bool SessionRegistry::close(std::uint64_t session_id, bool idle) {
+bool SessionRegistry::close(std::uint64_t session_id, CloseReason reason) {
   std::shared_ptr<ServerSession> session;
   {
     std::lock_guard lock(mutex_);
     session = removeLocked(session_id);
     if (session == nullptr) return false;
-    if (idle) ++idle_closed_;  // counted before the backend can go, for whoever watches it go
+    // Counted before the backend can go, for whoever watches it go.
+    if (reason == CloseReason::kIdle) ++idle_closed_;
   }
+  account(*session, reason);
   session->slices.close();
   return true;  // the backend goes when the last RPC using the session lets go
 }
@@ -160,7 +163,7 @@ std::size_t SessionRegistry::closeIdle(std::chrono::milliseconds idle_timeout) {
     }
   }
   std::size_t closed = 0;
-  for (const std::uint64_t id : idle) closed += close(id, true) ? 1 : 0;
+  for (const std::uint64_t id : idle) closed += close(id, CloseReason::kIdle) ? 1 : 0;
   return closed;
 }
 
@@ -170,7 +173,58 @@ void SessionRegistry::closeAll() {
     std::lock_guard lock(mutex_);
     for (const auto& entry : sessions_) ids.push_back(entry.first);
   }
-  for (const std::uint64_t id : ids) close(id);
+  for (const std::uint64_t id : ids) close(id, CloseReason::kShutdown);
+}
+
+void SessionRegistry::account(const ServerSession& s, CloseReason reason) {
+  const std::uint64_t pushed = s.slices.lastPushed();
+  const std::uint64_t acknowledged = s.slices.acknowledged();
+  const std::uint64_t unacknowledged = pushed - std::min(pushed, acknowledged);
+  const std::uint64_t dropped = s.slices.droppedUnacknowledged();
+  {
+    std::lock_guard lock(totals_mutex_);
+    ClosedSessionTotals& t = closed_totals_;
+    ++t.sessions;
+    switch (reason) {
+      case CloseReason::kByClient:
+        ++t.closed_by_client;
+        break;
+      case CloseReason::kIdle:
+        ++t.closed_idle;
+        break;
+      case CloseReason::kReclaimed:
+        ++t.closed_reclaimed;
+        break;
+      case CloseReason::kShutdown:
+        ++t.closed_at_shutdown;
+        break;
+    }
+    t.keyframes += s.keyframes.load();
+    t.duplicate_uploads += s.duplicate_uploads.load();
+    t.missing_uploads += s.missing_uploads.load();
+    t.slices_pushed += pushed;
+    t.slices_dropped += dropped;
+    t.slices_unacknowledged += unacknowledged;
+  }
+  // The last slice of a clean end is applied but never acknowledged (acknowledgements ride on
+  // uploads, and none follows it): not worth a warning.
+  if (reason == CloseReason::kByClient && unacknowledged <= 1 && dropped == 0 &&
+      s.missing_uploads.load() == 0) {
+    return;  // EdgeService logs the close
+  }
+  static constexpr const char* kReasons[] = {"by its client", "idle (its client went silent)",
+                                             "to make room", "at shutdown"};
+  spdlog::warn(
+      "edge server: session {:#x} ('{}') closed {}: {} keyframes received, {} uploads missing, "
+      "{} duplicate; {} of {} slices never acknowledged ({} dropped unacknowledged)",
+      s.config.session_id, s.config.client_name, kReasons[static_cast<int>(reason)],
+      s.keyframes.load(), s.missing_uploads.load(), s.duplicate_uploads.load(), unacknowledged,
+      pushed, dropped);
+}
+
+ClosedSessionTotals SessionRegistry::closedTotals() const {
+  std::lock_guard lock(totals_mutex_);
+  return closed_totals_;
 }
 
 std::vector<SessionStats> SessionRegistry::stats() const {
@@ -189,6 +243,7 @@ std::vector<SessionStats> SessionRegistry::stats() const {
     stats.downlink_bytes = s->downlink_bytes.load();
     stats.keyframes = s->keyframes.load();
     stats.duplicate_uploads = s->duplicate_uploads.load();
+    stats.missing_uploads = s->missing_uploads.load();
     stats.frames = s->frames.load();
     stats.slices_pushed = s->slices.lastPushed();
     stats.slices_sent = s->slices_sent.load();

@@ -49,6 +49,7 @@ struct ServerSession {
   std::atomic<std::uint64_t> downlink_bytes{0};
   std::atomic<std::uint64_t> keyframes{0};
   std::atomic<std::uint64_t> duplicate_uploads{0};
+  std::atomic<std::uint64_t> missing_uploads{0};
   std::atomic<std::uint64_t> frames{0};
   std::atomic<std::uint64_t> slices_sent{0};
   UploadRate upload_rate;  // guarded by backend_mutex
@@ -79,7 +80,7 @@ class SessionRegistry {
                                       const SessionOwner& owner = {});
   std::shared_ptr<ServerSession> find(std::uint64_t session_id) const;
   // Removes the session and closes its slice queue; false when unknown.
-  bool close(std::uint64_t session_id) { return close(session_id, false); }
+  bool close(std::uint64_t session_id) { return close(session_id, CloseReason::kByClient); }
   // Closes sessions without an open stream whose last activity is older than `idle_timeout`.
   std::size_t closeIdle(std::chrono::milliseconds idle_timeout);
   void closeAll();
@@ -88,9 +89,13 @@ class SessionRegistry {
   std::size_t size() const;
   std::uint64_t idleClosed() const { return idle_closed_.load(); }
   std::uint64_t reclaimed() const { return reclaimed_.load(); }
+  ClosedSessionTotals closedTotals() const;
 
  private:
-  bool close(std::uint64_t session_id, bool idle);
+  enum class CloseReason { kByClient, kIdle, kReclaimed, kShutdown };
+  bool close(std::uint64_t session_id, CloseReason reason);
+  // Adds a closed session to the totals and logs what it leaves undelivered.
+  void account(const ServerSession& session, CloseReason reason);
   std::uint8_t reserveOriginLocked(std::uint8_t preferred);
   // The session to close for a new one when full, or 0.
   std::uint64_t reclaimableLocked() const;
@@ -110,6 +115,8 @@ class SessionRegistry {
   std::atomic<std::uint64_t> idle_closed_{0};
   std::atomic<std::uint64_t> reclaimed_{0};
   std::map<std::string, std::size_t> owner_sessions_;  // open or being opened, per owner
+  mutable std::mutex totals_mutex_;
+  ClosedSessionTotals closed_totals_;
 };
 
 }  // namespace edgeslam

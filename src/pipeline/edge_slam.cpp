@@ -248,6 +248,7 @@ SlamCounters EdgeSlam::counters() const {
   out.points_forgotten = sink_->pointsForgotten();
   out.reconnects = link.reconnects;
   out.keyframes_uploaded = sink_->uploadsSent();
+  out.uploads_unanswered = sink_->uploadsInFlight();
   std::lock_guard lock(stats_mutex_);
   out.slices_applied = slices_applied_;
   out.loops = loops_;

@@ -17,7 +17,11 @@ struct RunHealth {
   double backend_wait_ms = 0.0;           // --fast: tracking's total wait for the back end
   double wall_ms = 0.0;
   bool monocular = false;
-  double keyframe_depth_ratio = 0.0;  // late / early keyframes' median depth (0 = unknown)
+  double keyframe_depth_ratio = 0.0;    // late / early keyframes' median depth (0 = unknown)
+  std::size_t frames_out_of_order = 0;  // skipped: timestamp repeated or going back
+  std::size_t frames_without_map = 0;   // processed before the first map (or after a reset)
+  bool map_built = true;
+  std::string refusals = {};  // initialisation refusals by cause, most frequent first ("" = none)
 };
 
 struct RunWarningThresholds {

@@ -94,7 +94,10 @@ struct SlamCounters {
   std::uint64_t downlink_bytes = 0;
   std::uint64_t keyframes_uploaded = 0;
   std::uint64_t uploads_dropped = 0;
-  std::uint64_t uploads_overflowed = 0;   // of those, pushed out of the link's full queue
+  std::uint64_t uploads_overflowed = 0;  // of those, pushed out of the link's full queue
+  // Sent, neither answered by a slice nor dropped when the run ended (a stalled link, a lost
+  // edge): the edge may or may not have them.
+  std::uint64_t uploads_unanswered = 0;
   std::uint64_t keyframes_forgotten = 0;  // by the client, their upload dropped
   std::uint64_t points_forgotten = 0;     // that went up with those uploads only
   std::uint64_t slices_applied = 0;
@@ -171,6 +174,8 @@ class SlamSystem {
   virtual std::size_t trackingRecoveries() const { return 0; }
   // Keyframes the client's tracker made, by rule (zeros where the client does not track).
   virtual KeyFrameDecisionCounts keyFrameDecisions() const { return {}; }
+  // Why frames had no map or were lost, per cause (nullopt where the client does not track).
+  virtual std::optional<TrackingDiagnostics> trackingDiagnostics() const { return std::nullopt; }
   virtual std::size_t mapResets() const = 0;
   // The last frame's semantic stage (mask, culled features); nullptr where the client does not
   // track (offload).
@@ -197,6 +202,9 @@ class TrackingSlam : public SlamSystem {
   std::size_t trackingRecoveries() const override { return tracker_->recoveries(); }
   KeyFrameDecisionCounts keyFrameDecisions() const override {
     return tracker_->keyFrameDecisions();
+  }
+  std::optional<TrackingDiagnostics> trackingDiagnostics() const override {
+    return tracker_->diagnostics();
   }
   std::size_t mapResets() const override { return tracker_->resets(); }
   // Always present: without semantic culling, every feature is kept and there is no mask.

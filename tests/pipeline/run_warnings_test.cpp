@@ -35,5 +35,25 @@ TEST(RunWarnings, NoneForAHealthyRun) {
   EXPECT_TRUE(runWarnings(health).empty());
 }
 
+TEST(RunWarnings, SayWhyThereWasNoMapAndWhichFramesWereSkipped) {
+  RunHealth never{.frames = 40, .tracked = 0, .lost = 0};
+  never.map_built = false;
+  never.frames_without_map = 40;
+  never.refusals = "low_parallax 39";
+  const auto none = runWarnings(never);
+  ASSERT_EQ(none.size(), 1u);
+  EXPECT_NE(none[0].find("no map was built in 40 frames"), std::string::npos) << none[0];
+  EXPECT_NE(none[0].find("low_parallax 39"), std::string::npos) << none[0];
+
+  RunHealth late{.frames = 100, .tracked = 60, .lost = 0};
+  late.frames_without_map = 35;
+  late.frames_out_of_order = 5;
+  late.refusals = "too_few_features 30";
+  const auto warnings = runWarnings(late);
+  ASSERT_EQ(warnings.size(), 2u);
+  EXPECT_NE(warnings[0].find("5 of 100 frames skipped"), std::string::npos) << warnings[0];
+  EXPECT_NE(warnings[1].find("no map on 35 of 95 frames"), std::string::npos) << warnings[1];
+}
+
 }  // namespace
 }  // namespace edgeslam
