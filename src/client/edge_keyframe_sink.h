@@ -36,6 +36,11 @@ class EdgeKeyFrameSink : public KeyFrameSink {
   EdgeKeyFrameSink(Map& map, KeyFrameUplink& uplink, EdgeKeyFrameSinkOptions options = {});
 
   void insertKeyFrame(KeyFrame* keyframe) override;
+  // Uploads again a keyframe the edge lost (a full resync did not list it), with every point of
+  // this client it sees (the edge skips those it has). Call on the tracking thread, as
+  // insertKeyFrame, so that uploads leave in sequence order. False when the keyframe is gone.
+  bool resendKeyFrame(KeyFrameId keyframe);
+  std::uint64_t keyFramesResent() const { return keyframes_resent_.load(); }
   bool acceptsKeyFrames() const override;
   bool acceptsUrgentKeyFrames() const override;
   std::size_t lastOptimizedFrame() const override { return last_optimized_frame_.load(); }
@@ -80,6 +85,8 @@ class EdgeKeyFrameSink : public KeyFrameSink {
   // Uploads remembered for onUploadDropped: well beyond the link's queue and those in flight.
   static constexpr std::size_t kRememberedUploads = 64;
 
+  void sendUpload(KeyFrame* keyframe, bool resend);
+
   Map& map_;
   KeyFrameUplink& uplink_;
   EdgeKeyFrameSinkOptions options_;
@@ -96,6 +103,7 @@ class EdgeKeyFrameSink : public KeyFrameSink {
   std::deque<std::pair<std::uint64_t, Clock::time_point>> sent_times_;
   std::set<std::uint64_t> dropped_unanswered_;  // dropped sequences above answered_
   std::atomic<std::uint64_t> keyframes_forgotten_{0};
+  std::atomic<std::uint64_t> keyframes_resent_{0};
   std::atomic<std::uint64_t> points_forgotten_{0};
 };
 

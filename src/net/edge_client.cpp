@@ -130,6 +130,7 @@ struct EdgeClient::Impl {
     }
     session_id.store(reply.session_id());
     id_origin.store(static_cast<std::uint8_t>(reply.id_origin()));
+    id_floor.store(reply.id_floor());
     uplink += request.ByteSizeLong();
     downlink += reply.ByteSizeLong();
     return status;
@@ -267,6 +268,7 @@ struct EdgeClient::Impl {
         upload = std::move(queue.front());
         queue.pop_front();
         in_flight = true;
+        in_flight_keyframe = upload.keyframe.id;
         which = identify(upload);
       }
       v1::UploadKeyFrameRequest request;
@@ -447,6 +449,7 @@ struct EdgeClient::Impl {
 
   std::atomic<std::uint64_t> session_id{0};
   std::atomic<std::uint8_t> id_origin{0};
+  std::atomic<std::uint64_t> id_floor{0};
   std::mutex reopen_mutex;
   std::atomic<std::uint64_t> last_applied{0};
   std::atomic<bool> resync_pending{false};
@@ -458,6 +461,7 @@ struct EdgeClient::Impl {
   bool closed = false;
   std::deque<KeyFrameUpload> queue;
   bool in_flight = false;
+  KeyFrameId in_flight_keyframe = kInvalidId;
   std::uint64_t last_upload_sequence = 0;
   grpc::ClientContext* upload_context = nullptr;
   grpc::ClientContext* stream_context = nullptr;
@@ -491,6 +495,19 @@ std::uint64_t EdgeClient::sessionId() const {
 
 std::uint8_t EdgeClient::idOrigin() const {
   return impl_->id_origin.load();
+}
+
+std::uint64_t EdgeClient::idFloor() const {
+  return impl_->id_floor.load();
+}
+
+std::vector<KeyFrameId> EdgeClient::pendingUploadKeyFrames() const {
+  std::lock_guard lock(impl_->mutex);
+  std::vector<KeyFrameId> out;
+  out.reserve(impl_->queue.size() + 1);
+  if (impl_->in_flight) out.push_back(impl_->in_flight_keyframe);
+  for (const KeyFrameUpload& upload : impl_->queue) out.push_back(upload.keyframe.id);
+  return out;
 }
 
 std::uint64_t EdgeClient::uploadKeyFrame(KeyFrameUpload upload) {
