@@ -43,7 +43,9 @@ TEST(SliceSplitting, PartsFitAndKeepEveryRecordWithTheHeaderLast) {
     EXPECT_EQ(parts[i].full_resync, i + 1 == parts.size()) << "part " << i;
     EXPECT_EQ(parts[i].newest_keyframe, whole.newest_keyframe);
     // Keyframe records come before the points that may observe them.
-    if (!parts[i].points_upserted.empty()) EXPECT_EQ(keyframes, whole.keyframes.size());
+    if (!parts[i].points_upserted.empty()) {
+      EXPECT_EQ(keyframes, whole.keyframes.size());
+    }
     keyframes += parts[i].keyframes.size();
     points += parts[i].points_upserted.size();
   }
