@@ -159,6 +159,9 @@ std::unique_ptr<SlamSystem> makeSlamSystem(const RunOptions& options, const std:
   client_options.credentials = loadClientCredentials(options.security);
   client_options.keyframe_image.downscale = options.segment_reduce;
   client_options.omit_known_point_descriptors = options.omit_known_point_descriptors;
+  // Room for the keyframes tracking makes while the edge is unreachable (EdgeKeyFrameSink's
+  // max_in_flight_reconnecting); otherwise the sink's own bound keeps the queue short.
+  client_options.upload_queue_capacity = 32;
   auto link = std::make_unique<GrpcEdgeLink>(edge.address, config, client_options);
   AdaptationLoopOptions adaptation;
   adaptation.adapt = options.adapt;

@@ -85,11 +85,16 @@ std::uint64_t EdgeKeyFrameSink::uploadsInFlight() const {
 }
 
 bool EdgeKeyFrameSink::acceptsKeyFrames() const {
-  return uploadsInFlight() < options_.max_in_flight;
+  const std::size_t limit =
+      uplink_.reconnecting() ? options_.max_in_flight_reconnecting : options_.max_in_flight;
+  return uploadsInFlight() < limit;
 }
 
 bool EdgeKeyFrameSink::acceptsUrgentKeyFrames() const {
-  return uploadsInFlight() < options_.max_in_flight + options_.urgent_extra_in_flight;
+  const std::size_t limit = uplink_.reconnecting()
+                                ? options_.max_in_flight_reconnecting
+                                : options_.max_in_flight + options_.urgent_extra_in_flight;
+  return uploadsInFlight() < limit;
 }
 
 void EdgeKeyFrameSink::onMapReset() {

@@ -26,6 +26,10 @@ struct EdgeKeyFrameSinkOptions {
   // is dropped for it): behind a congested link the edge answers seconds late, and a monocular
   // client refused its keyframes lost tracking for good at the first fast turn.
   std::size_t urgent_extra_in_flight = 3;
+  // While the edge is unreachable (uplink reconnecting) tracking goes on making keyframes at its
+  // own pace, up to this many unanswered: they wait in the uplink's queue (which must hold more)
+  // and reach the edge when it is back. Refusing them starved tracking through a server restart.
+  std::size_t max_in_flight_reconnecting = 24;
   // With the camera, new points that are the depth back-projection of their keypoint in the
   // uploaded keyframe are flagged so that the wire leaves their positions out (~12 bytes each).
   std::optional<PinholeCamera> camera;

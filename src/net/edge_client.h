@@ -107,6 +107,9 @@ class EdgeClient {
   // Ids of this origin the session's map already held when it opened (a map the edge loaded from
   // its store): make ids above it. 0 = none.
   std::uint64_t idFloor() const;
+  // The last upload attempt failed for want of the server (unreachable, or its session lost and
+  // not reopened yet); false again once an upload goes through.
+  bool reconnecting() const;
   // Keyframes whose upload is queued or being sent (not yet acknowledged by the server).
   std::vector<KeyFrameId> pendingUploadKeyFrames() const;
 

@@ -19,6 +19,7 @@ class GrpcEdgeLink : public EdgeLink {
   void send(KeyFrameUpload upload) override;
   std::uint8_t idOrigin() const override { return client_->idOrigin(); }
   std::uint64_t idFloor() const override { return client_->idFloor(); }
+  bool reconnecting() const override { return client_->reconnecting(); }
   std::vector<KeyFrameId> pendingKeyFrames() const override {
     return client_->pendingUploadKeyFrames();
   }
