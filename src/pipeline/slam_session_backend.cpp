@@ -161,8 +161,9 @@ void SlamSessionBackend::onKeyFrame(KeyFrameUpload upload) {
 }
 
 void SlamSessionBackend::onFullResyncRequested() {
-  // Before the first keyframe there is nothing to send: the client's uploads make the map.
-  if (!mapping_) return;
+  // A session with nothing mapped yet (no stored map to resume) answers with an empty map: the
+  // client then sends again every keyframe it holds.
+  if (!mapping_) makeMapping(std::nullopt);
   mapping_->publishFullResync();
 }
 
