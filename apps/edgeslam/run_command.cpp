@@ -485,13 +485,12 @@ int runPipeline(const RunOptions& given) {
                              {"keyframes_entered", c.keyframes_entered}};
     // Every keyframe the client made is on the edge, on its way, or lost for a reason below.
     const ResyncCounters r = edge_slam->resyncCounters();
-    metrics["resync"] = {
-        {"full_resyncs", r.full_resyncs},
-        {"keyframes_made", counters.keyframes_uploaded - r.keyframes_resent},
-        {"keyframes_resent", r.keyframes_resent},
-        {"keyframes_lost",
-         {{"upload_dropped", counters.keyframes_forgotten},
-          {"evicted_before_stored", r.keyframes_lost_evicted}}}};
+    metrics["resync"] = {{"full_resyncs", r.full_resyncs},
+                         {"keyframes_made", counters.keyframes_uploaded - r.keyframes_resent},
+                         {"keyframes_resent", r.keyframes_resent},
+                         {"keyframes_lost",
+                          {{"upload_dropped", counters.keyframes_forgotten},
+                           {"evicted_before_stored", r.keyframes_lost_evicted}}}};
     const KeyFrameTriangulationStats& t = edge_slam->clientTriangulation();
     if (t.keyframes > 0) {
       const PercentileSummary ms = t.ms.summary();

@@ -61,7 +61,7 @@ struct EdgeMapSessionStats {
   // Uploads of a keyframe the map already had (a client re-sending after a full resync): answered
   // by a slice, not mapped again.
   std::uint64_t uploads_duplicate = 0;
-  std::uint64_t full_resyncs = 0;  // slices with full_resync published
+  std::uint64_t full_resyncs = 0;      // slices with full_resync published
   std::uint64_t keyframes_loaded = 0;  // by options.preload
   double load_describe_ms = 0.0;       // bags of words of those
 };

@@ -48,8 +48,7 @@ bool onlyRecords(const MapSlice& s) {
 }
 
 std::size_t recordCount(const MapSlice& s) {
-  return s.keyframes.size() + s.points_upserted.size() + s.point_positions.size() +
-         s.masks.size();
+  return s.keyframes.size() + s.points_upserted.size() + s.point_positions.size() + s.masks.size();
 }
 
 void split(MapSlice slice, std::size_t max_bytes,

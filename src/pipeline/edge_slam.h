@@ -27,7 +27,7 @@ struct ClientMapSize {
 // What full resyncs (a reconnection after the edge lost its session) did to the client's
 // keyframes: each one the client made is on the edge, re-sent, or lost for a reason counted here.
 struct ResyncCounters {
-  std::uint64_t full_resyncs = 0;     // slices with full_resync applied
+  std::uint64_t full_resyncs = 0;      // slices with full_resync applied
   std::uint64_t keyframes_resent = 0;  // the edge lacked them: uploaded again
   // The edge lacked them and the client no longer had their features (evicted from its bounded
   // map before the edge stored them): lost.

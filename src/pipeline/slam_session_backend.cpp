@@ -139,8 +139,9 @@ void SlamSessionBackend::makeMapping(std::optional<StoredSession> resumed) {
       rebuild_ms = timer.elapsedMs();
     };
   }
-  mapping_ = std::make_unique<EdgeMapSession>(config_.camera, config_.sensor, mapping,
-                                              [this](MapSlice slice) { publish(std::move(slice)); });
+  mapping_ =
+      std::make_unique<EdgeMapSession>(config_.camera, config_.sensor, mapping,
+                                       [this](MapSlice slice) { publish(std::move(slice)); });
   if (resumed) {
     const EdgeMapSessionStats loaded = mapping_->stats();
     const std::size_t keyframes = std::max<std::size_t>(1, loaded.keyframes_loaded);

@@ -32,8 +32,8 @@ std::filesystem::path tempDir(const std::string& name) {
 }
 
 int startInBackground(const std::string& arguments, const std::filesystem::path& log) {
-  const std::string command = test::edgeslamBinary().string() + " " + arguments + " > " +
-                              log.string() + " 2>&1 & echo $!";
+  const std::string command =
+      test::edgeslamBinary().string() + " " + arguments + " > " + log.string() + " 2>&1 & echo $!";
   FILE* pipe = ::popen(command.c_str(), "r");
   int pid = 0;
   if (pipe == nullptr || std::fscanf(pipe, "%d", &pid) != 1) pid = 0;
@@ -47,8 +47,8 @@ nlohmann::json readJson(const std::filesystem::path& file) {
 }
 
 struct RunFigures {
-  nlohmann::json metrics;   // the client's metrics.json
-  nlohmann::json map_info;  // `map info --json` of the store afterwards
+  nlohmann::json metrics;        // the client's metrics.json
+  nlohmann::json map_info;       // `map info --json` of the store afterwards
   double keyframe_ate_m = -1.0;  // the stored edge map's keyframes against the ground truth
   std::string client_output;
 };
@@ -71,10 +71,9 @@ RunFigures runClient(const std::string& name, std::optional<std::chrono::millise
   std::this_thread::sleep_for(std::chrono::milliseconds(800));
   test::CommandResult client;
   std::thread client_thread([&] {
-    client = test::runEdgeslam("client --server " + address + " --dataset " +
-                               test::sharedPath(kSequence).string() +
-                               " --sensor rgbd --realtime --vocab none --map kitchen --out " +
-                               out.string());
+    client = test::runEdgeslam(
+        "client --server " + address + " --dataset " + test::sharedPath(kSequence).string() +
+        " --sensor rgbd --realtime --vocab none --map kitchen --out " + out.string());
   });
   if (kill_after) {
     std::this_thread::sleep_for(*kill_after);
@@ -91,14 +90,14 @@ RunFigures runClient(const std::string& name, std::optional<std::chrono::millise
   figures.metrics = readJson(out / "metrics.json");
   const auto info = test::runEdgeslam("map info kitchen --json --maps " + store.string(), false);
   figures.map_info = nlohmann::json::parse(info.output, nullptr, false);
-  const auto exported = test::runEdgeslam("map export kitchen --format tum --out " +
-                                          (out / "edge_keyframes.tum").string() + " --maps " +
-                                          store.string());
+  const auto exported =
+      test::runEdgeslam("map export kitchen --format tum --out " +
+                        (out / "edge_keyframes.tum").string() + " --maps " + store.string());
   EXPECT_EQ(exported.exit_code, 0) << exported.output;
-  const auto ate = test::runEdgeslam("eval ate --gt " + (out / "groundtruth.tum").string() +
-                                         " --est " + (out / "edge_keyframes.tum").string() +
-                                         " --align se3 --json",
-                                     false);
+  const auto ate =
+      test::runEdgeslam("eval ate --gt " + (out / "groundtruth.tum").string() + " --est " +
+                            (out / "edge_keyframes.tum").string() + " --align se3 --json",
+                        false);
   const auto ate_json = nlohmann::json::parse(ate.output, nullptr, false);
   if (ate_json.is_object() && ate_json.contains("rmse_m")) {
     figures.keyframe_ate_m = ate_json["rmse_m"].get<double>();
