@@ -166,6 +166,9 @@ std::unique_ptr<SlamSystem> makeSlamSystem(const RunOptions& options, const std:
   client_options.credentials = loadClientCredentials(options.security);
   client_options.keyframe_image.downscale = options.segment_reduce;
   client_options.omit_known_point_descriptors = options.omit_known_point_descriptors;
+  // Room for the keyframes tracking makes while the edge is unreachable (EdgeKeyFrameSink's
+  // max_in_flight_reconnecting); otherwise the sink's own bound keeps the queue short.
+  client_options.upload_queue_capacity = 32;
   auto link = std::make_unique<GrpcEdgeLink>(edge.address, config, client_options);
   AdaptationLoopOptions adaptation;
   adaptation.adapt = options.adapt;
@@ -516,6 +519,14 @@ int runPipeline(const RunOptions& given) {
                              {"max_points", c.max_points},
                              {"keyframes_evicted", c.keyframes_evicted},
                              {"keyframes_entered", c.keyframes_entered}};
+    // Every keyframe the client made is on the edge, on its way, or lost for a reason below.
+    const ResyncCounters r = edge_slam->resyncCounters();
+    metrics["resync"] = {{"full_resyncs", r.full_resyncs},
+                         {"keyframes_made", counters.keyframes_uploaded - r.keyframes_resent},
+                         {"keyframes_resent", r.keyframes_resent},
+                         {"keyframes_lost",
+                          {{"upload_dropped", counters.keyframes_forgotten},
+                           {"evicted_before_stored", r.keyframes_lost_evicted}}}};
     const KeyFrameTriangulationStats& t = edge_slam->clientTriangulation();
     if (t.keyframes > 0) {
       const PercentileSummary ms = t.ms.summary();

@@ -13,6 +13,22 @@ EdgeKeyFrameSink::EdgeKeyFrameSink(Map& map, KeyFrameUplink& uplink,
     : map_(map), uplink_(uplink), options_(options) {}
 
 void EdgeKeyFrameSink::insertKeyFrame(KeyFrame* keyframe) {
+  sendUpload(keyframe, false);
+}
+
+bool EdgeKeyFrameSink::resendKeyFrame(KeyFrameId id) {
+  KeyFrame* keyframe = nullptr;
+  {
+    std::lock_guard lock(map_.updateMutex());
+    keyframe = map_.keyFrame(id);
+    if (keyframe == nullptr || keyframe->isBad() || keyframe->isEvicted()) return false;
+  }
+  sendUpload(keyframe, true);
+  ++keyframes_resent_;
+  return true;
+}
+
+void EdgeKeyFrameSink::sendUpload(KeyFrame* keyframe, bool resend) {
   KeyFrameUpload upload;
   {
     std::lock_guard lock(map_.updateMutex());
@@ -20,7 +36,9 @@ void EdgeKeyFrameSink::insertKeyFrame(KeyFrame* keyframe) {
     upload.keyframe = keyFrameRecord(*keyframe);
     const std::uint8_t own_origin = idOrigin(keyframe->id());
     for (MapPoint* p : keyframe->goodPoints()) {
-      if (idOrigin(p->id()) != own_origin || uploaded_points_.contains(p->id())) continue;
+      if (idOrigin(p->id()) != own_origin || (!resend && uploaded_points_.contains(p->id()))) {
+        continue;
+      }
       MapPointRecord record = mapPointRecord(*p);
       record.position_from_depth =
           options_.camera.has_value() && isDepthBackProjection(*p, *keyframe, *options_.camera);
@@ -28,9 +46,11 @@ void EdgeKeyFrameSink::insertKeyFrame(KeyFrame* keyframe) {
       uploaded_points_.insert(p->id());
     }
     upload.segmenter_nms = segmenter_nms_.load();
-    upload.map_reset = reset_pending_;
-    reset_pending_ = false;
-    if (!image_.empty() && image_frame_ == keyframe->frameIndex()) upload.raw_image = image_;
+    if (!resend) {
+      upload.map_reset = reset_pending_;
+      reset_pending_ = false;
+      if (!image_.empty() && image_frame_ == keyframe->frameIndex()) upload.raw_image = image_;
+    }
     upload.sequence = sequence_.load() + 1;
     UploadRecord record{upload.sequence, keyframe->id(), {}, upload.map_reset};
     record.new_points.reserve(upload.new_points.size());
@@ -65,11 +85,16 @@ std::uint64_t EdgeKeyFrameSink::uploadsInFlight() const {
 }
 
 bool EdgeKeyFrameSink::acceptsKeyFrames() const {
-  return uploadsInFlight() < options_.max_in_flight;
+  const std::size_t limit =
+      uplink_.reconnecting() ? options_.max_in_flight_reconnecting : options_.max_in_flight;
+  return uploadsInFlight() < limit;
 }
 
 bool EdgeKeyFrameSink::acceptsUrgentKeyFrames() const {
-  return uploadsInFlight() < options_.max_in_flight + options_.urgent_extra_in_flight;
+  const std::size_t limit = uplink_.reconnecting()
+                                ? options_.max_in_flight_reconnecting
+                                : options_.max_in_flight + options_.urgent_extra_in_flight;
+  return uploadsInFlight() < limit;
 }
 
 void EdgeKeyFrameSink::onMapReset() {

@@ -26,6 +26,10 @@ struct EdgeKeyFrameSinkOptions {
   // is dropped for it): behind a congested link the edge answers seconds late, and a monocular
   // client refused its keyframes lost tracking for good at the first fast turn.
   std::size_t urgent_extra_in_flight = 3;
+  // While the edge is unreachable (uplink reconnecting) tracking goes on making keyframes at its
+  // own pace, up to this many unanswered: they wait in the uplink's queue (which must hold more)
+  // and reach the edge when it is back. Refusing them starved tracking through a server restart.
+  std::size_t max_in_flight_reconnecting = 24;
   // With the camera, new points that are the depth back-projection of their keypoint in the
   // uploaded keyframe are flagged so that the wire leaves their positions out (~12 bytes each).
   std::optional<PinholeCamera> camera;
@@ -36,6 +40,11 @@ class EdgeKeyFrameSink : public KeyFrameSink {
   EdgeKeyFrameSink(Map& map, KeyFrameUplink& uplink, EdgeKeyFrameSinkOptions options = {});
 
   void insertKeyFrame(KeyFrame* keyframe) override;
+  // Uploads again a keyframe the edge lost (a full resync did not list it), with every point of
+  // this client it sees (the edge skips those it has). Call on the tracking thread, as
+  // insertKeyFrame, so that uploads leave in sequence order. False when the keyframe is gone.
+  bool resendKeyFrame(KeyFrameId keyframe);
+  std::uint64_t keyFramesResent() const { return keyframes_resent_.load(); }
   bool acceptsKeyFrames() const override;
   bool acceptsUrgentKeyFrames() const override;
   std::size_t lastOptimizedFrame() const override { return last_optimized_frame_.load(); }
@@ -80,6 +89,8 @@ class EdgeKeyFrameSink : public KeyFrameSink {
   // Uploads remembered for onUploadDropped: well beyond the link's queue and those in flight.
   static constexpr std::size_t kRememberedUploads = 64;
 
+  void sendUpload(KeyFrame* keyframe, bool resend);
+
   Map& map_;
   KeyFrameUplink& uplink_;
   EdgeKeyFrameSinkOptions options_;
@@ -96,6 +107,7 @@ class EdgeKeyFrameSink : public KeyFrameSink {
   std::deque<std::pair<std::uint64_t, Clock::time_point>> sent_times_;
   std::set<std::uint64_t> dropped_unanswered_;  // dropped sequences above answered_
   std::atomic<std::uint64_t> keyframes_forgotten_{0};
+  std::atomic<std::uint64_t> keyframes_resent_{0};
   std::atomic<std::uint64_t> points_forgotten_{0};
 };
 

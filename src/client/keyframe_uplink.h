@@ -9,6 +9,8 @@ class KeyFrameUplink {
  public:
   virtual ~KeyFrameUplink() = default;
   virtual void send(KeyFrameUpload upload) = 0;
+  // The edge is unreachable for now (uploads wait in the uplink's queue until it is back).
+  virtual bool reconnecting() const { return false; }
 };
 
 }  // namespace edgeslam

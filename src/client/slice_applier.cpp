@@ -132,6 +132,15 @@ SliceApplyResult applySlice(Map& map, const MapSlice& slice, const PinholeCamera
   for (KeyFrame* kf : touched) {
     if (kf != nullptr && !kf->isBad() && !kf->isEvicted()) map.updateConnections(kf);
   }
+  if (slice.full_resync) {
+    std::unordered_set<KeyFrameId> on_edge;
+    for (const KeyFramePoseRecord& record : slice.keyframe_poses) on_edge.insert(record.id);
+    for (const KeyFrame* kf : map.keyFrames()) {
+      if (!kf->isBad() && !on_edge.contains(kf->id())) {
+        result.keyframes_edge_lacks.push_back(kf->id());
+      }
+    }
+  }
   if (const KeyFrame* processed = map.keyFrame(slice.processed_keyframe)) {
     result.frame_index = processed->frameIndex();
   }

@@ -5,8 +5,10 @@
 // evicts keep only their poses (their observations go, and the points no held keyframe sees),
 // and keyframes back in the window get their features and points again; records naming what the
 // client does not hold are ignored. Keyframes the client made after the slice's keyframe, and the
-// points they made, follow that keyframe's correction rigidly. Takes the map's update mutex for the
-// duration.
+// points they made, follow that keyframe's correction rigidly. A slice with full_resync lists every
+// keyframe of the edge's map: the client takes each pose and point it carries, keeps what it made
+// that the edge lacks, and is told which keyframes those are (to send them again). Takes the map's
+// update mutex for the duration.
 #include <cstddef>
 #include <vector>
 
@@ -31,6 +33,8 @@ struct SliceApplyResult {
   // The client's map after the slice: keyframes held (not evicted) and points.
   std::size_t keyframes_held = 0;
   std::size_t points_held = 0;
+  // A full resync: the keyframes the client has (held or evicted) that the edge's map lacks.
+  std::vector<KeyFrameId> keyframes_edge_lacks;
 };
 
 SliceApplyResult applySlice(Map& map, const MapSlice& slice, const PinholeCamera& camera);

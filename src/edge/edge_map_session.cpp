@@ -11,6 +11,7 @@
 #include "edge/slice_builder.h"
 #include "map/map_replication.h"
 #include "semantic/label_encoding.h"
+#include "util/timing_stats.h"
 
 namespace edgeslam {
 
@@ -31,6 +32,7 @@ EdgeMapSession::EdgeMapSession(const PinholeCamera& camera, Sensor sensor,
           : options.mapper.thread_nice;
   options.mapper.thread_nice = mapping_nice;
   mapper_ = std::make_unique<LocalMapper>(map_, camera_, options.mapper);
+  if (options.preload) options.preload(map_);
   if (options.vocabulary != nullptr && options.loop_closing) {
     LoopCloserOptions loop = loopCloserOptionsFor(sensor);
     loop.threaded = threaded_;
@@ -38,8 +40,9 @@ EdgeMapSession::EdgeMapSession(const PinholeCamera& camera, Sensor sensor,
     loop_closer_ =
         std::make_unique<LoopCloser>(map_, camera_, options.vocabulary, loop, mapper_.get());
     loop_closer_->setMapCorrectedCallback([this] { publishSlice(nullptr); });
-    loop_closer_->start();
   }
+  adoptPreloadedMap();
+  if (loop_closer_) loop_closer_->start();
   mapper_->setKeyFrameMappedCallback([this](KeyFrame* kf) {
     publishSlice(kf);
     if (loop_closer_) loop_closer_->insertKeyFrame(kf);
@@ -50,6 +53,32 @@ EdgeMapSession::EdgeMapSession(const PinholeCamera& camera, Sensor sensor,
         [this](KeyFrameSegmentationResult result) { onSegmented(std::move(result)); });
   }
   if (threaded_) mapper_->start();
+}
+
+void EdgeMapSession::adoptPreloadedMap() {
+  std::vector<KeyFrame*> loaded;
+  KeyFrameId newest = kInvalidId;
+  {
+    std::lock_guard lock(map_.updateMutex());
+    for (KeyFrame* keyframe : map_.keyFrames()) {
+      if (keyframe->isBad()) continue;
+      loaded.push_back(keyframe);
+      window_.clientHolds(keyframe->id());
+      newest = std::max(newest, keyframe->id());
+    }
+  }
+  if (loaded.empty()) return;
+  // Before the threads start: nothing else touches the keyframes' places or the loop database.
+  Stopwatch timer;
+  for (KeyFrame* keyframe : loaded) {
+    mapper_->describe(keyframe);
+    if (loop_closer_) loop_closer_->fileKeyFrame(keyframe);
+  }
+  std::lock_guard state(state_mutex_);
+  newest_keyframe_ = newest;
+  stats_.keyframes_loaded = loaded.size();
+  stats_.load_describe_ms = timer.elapsedMs();
+  stats_.keyframes = loaded.size();
 }
 
 EdgeMapSession::~EdgeMapSession() {
@@ -81,7 +110,18 @@ void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
   }
   KeyFrame* keyframe = nullptr;
   {
-    std::lock_guard lock(map_.updateMutex());
+    std::unique_lock lock(map_.updateMutex());
+    if (!upload.map_reset && map_.keyFrame(upload.keyframe.id) != nullptr) {
+      // Re-sent after a full resync while its first upload was still on its way, or sent to a
+      // server that stored it before a restart: the map has it. The client waits for an answer.
+      lock.unlock();
+      {
+        std::lock_guard state(state_mutex_);
+        ++stats_.uploads_duplicate;
+      }
+      publishSlice(nullptr, upload.sequence);
+      return;
+    }
     if (upload.map_reset) {
       mapper_->onMapReset();
       if (loop_closer_) loop_closer_->onMapReset();
@@ -159,7 +199,7 @@ void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
   }
 }
 
-void EdgeMapSession::publishSlice(KeyFrame* mapped) {
+void EdgeMapSession::publishSlice(KeyFrame* mapped, std::uint64_t answers) {
   std::lock_guard publishing(publish_mutex_);
   MapSlice slice;
   {
@@ -170,7 +210,8 @@ void EdgeMapSession::publishSlice(KeyFrame* mapped) {
       std::lock_guard state(state_mutex_);
       masks.swap(pending_masks_);
     }
-    if (mapped == nullptr && map_.changes().empty() && loops == loops_published_ && masks.empty()) {
+    if (mapped == nullptr && answers == 0 && map_.changes().empty() && loops == loops_published_ &&
+        masks.empty()) {
       return;
     }
     MapChanges changes = map_.takeChanges();
@@ -199,7 +240,7 @@ void EdgeMapSession::publishSlice(KeyFrame* mapped) {
     slice.sequence = ++slice_sequence_;
     // A correction answers no upload.
     // The slice answers the upload of the keyframe it mapped (later uploads may be queued).
-    slice.upload_sequence = 0;
+    slice.upload_sequence = answers;
     if (mapped != nullptr) {
       const auto it = upload_of_keyframe_.find(mapped->id());
       if (it != upload_of_keyframe_.end()) {
@@ -216,6 +257,38 @@ void EdgeMapSession::publishSlice(KeyFrame* mapped) {
     }
     stats_.keyframes = map_.keyFrameCount();
     stats_.map_points = map_.pointCount();
+  }
+  if (publish_) publish_(std::move(slice));
+}
+
+void EdgeMapSession::publishFullResync() {
+  std::lock_guard publishing(publish_mutex_);
+  MapSlice slice;
+  {
+    std::lock_guard lock(map_.updateMutex());
+    // What changed since the last slice is in the whole map sent now; the store still needs it.
+    MapChanges changes = map_.takeChanges();
+    if (observer_ != nullptr) observer_->onMapChanged(changes);
+    slice.full_resync = true;
+    for (const KeyFrame* keyframe : map_.keyFrames()) {
+      if (keyframe->isBad()) continue;
+      slice.keyframe_poses.push_back(keyFramePoseRecord(*keyframe));
+    }
+    for (const MapPoint* point : map_.mapPoints()) {
+      if (!point->isBad()) slice.points_upserted.push_back(mapPointRecord(*point));
+    }
+    // Points are attached only to keyframes the client holds; a bounded client ignores the rest.
+    slice.map_keyframes = map_.keyFrameCount();
+    slice.map_points = map_.pointCount();
+    const std::size_t loops = loop_closer_ ? loop_closer_->loops() : 0;
+    slice.loops_closed = static_cast<std::uint32_t>(loops - loops_published_);
+    loops_published_ = loops;
+    std::lock_guard state(state_mutex_);
+    slice.sequence = ++slice_sequence_;
+    // newest_keyframe stays unset: the client must not drop observations in its own keyframes
+    // that the edge lacks (it re-sends those keyframes).
+    ++stats_.slices;
+    ++stats_.full_resyncs;
   }
   if (publish_) publish_(std::move(slice));
 }

@@ -38,6 +38,10 @@ struct EdgeMapSessionOptions {
   int movable_point_erode_px = 2;
   // The client's bounded map (window.keyframes = 0: it replicates the whole global map).
   ClientMapWindowOptions window;
+  // Fills the empty global map before the session's threads start (a stored map resumed after a
+  // server restart); its keyframes are then described (bags of words), filed for place
+  // recognition and taken as held by the client.
+  std::function<void(Map&)> preload;
 };
 
 struct EdgeMapSessionStats {
@@ -54,6 +58,12 @@ struct EdgeMapSessionStats {
   // (the point was gone: the keypoint keeps neither point nor descriptor).
   std::uint64_t descriptors_filled = 0;
   std::uint64_t descriptors_lost = 0;
+  // Uploads of a keyframe the map already had (a client re-sending after a full resync): answered
+  // by a slice, not mapped again.
+  std::uint64_t uploads_duplicate = 0;
+  std::uint64_t full_resyncs = 0;      // slices with full_resync published
+  std::uint64_t keyframes_loaded = 0;  // by options.preload
+  double load_describe_ms = 0.0;       // bags of words of those
 };
 
 class EdgeMapSession {
@@ -71,6 +81,10 @@ class EdgeMapSession {
   // name (fillOmittedDescriptors). Throws std::invalid_argument for records that contradict
   // themselves.
   void onKeyFrame(const KeyFrameUpload& upload);
+  // Publishes a slice with full_resync set: the pose of every keyframe the edge map holds (the
+  // list a client compares with its own to re-send what the edge lacks) and every point. The
+  // changes pending are taken by it (and told to the observer) as an ordinary slice takes them.
+  void publishFullResync();
   // Waits until every queued keyframe is mapped and its slice published.
   void finish();
   void stop();
@@ -91,7 +105,9 @@ class EdgeMapSession {
 
  private:
   // `mapped`: the keyframe just mapped, or nullptr for a loop correction or global BA.
-  void publishSlice(KeyFrame* mapped);
+  // `answers`: an upload the slice answers although nothing was mapped for it (a duplicate).
+  void publishSlice(KeyFrame* mapped, std::uint64_t answers = 0);
+  void adoptPreloadedMap();
   void onSegmented(KeyFrameSegmentationResult result);
 
   PinholeCamera camera_;

@@ -88,6 +88,8 @@ class LocalMapper : public KeyFrameSink {
   void waitUntilIdle();
 
   void insertKeyFrame(KeyFrame* keyframe) override;
+  // The keyframe's bag of words and direct index (once; no-op without bag-of-words search).
+  void describe(KeyFrame* keyframe) const;
   bool acceptsKeyFrames() const override;
   std::size_t lastOptimizedFrame() const override { return last_optimized_frame_.load(); }
   void onMapReset() override;
@@ -111,7 +113,6 @@ class LocalMapper : public KeyFrameSink {
   void linkKeyFrame(KeyFrame* keyframe);
   void observeRecentPoints(KeyFrame* keyframe);
   void cullRecentPoints(KeyFrame* keyframe);
-  void describe(KeyFrame* keyframe) const;
   bool searchesByBow() const;
   void createNewPoints(KeyFrame* keyframe);
   void fuseWithNeighbours(KeyFrame* keyframe);

@@ -87,6 +87,12 @@ void LoopCloser::processAll() {
   }
 }
 
+void LoopCloser::fileKeyFrame(KeyFrame* keyframe) {
+  detector_.describe(*keyframe);
+  std::lock_guard lock(map_.updateMutex());
+  if (!keyframe->isBad()) detector_.detect(keyframe, map_, /*search=*/false, /*store=*/true);
+}
+
 void LoopCloser::waitUntilIdle() {
   if (!options_.threaded || !thread_.joinable()) {
     if (!options_.threaded) processAll();

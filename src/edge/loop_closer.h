@@ -85,6 +85,9 @@ class LoopCloser {
   void stop();
   // Queues a mapped keyframe (any thread).
   void insertKeyFrame(KeyFrame* keyframe);
+  // Files a keyframe of a loaded map for place recognition, without searching a loop for it.
+  // Before start() (or unthreaded, between keyframes).
+  void fileKeyFrame(KeyFrame* keyframe);
   // Unthreaded: processes the queue now. Threaded: same as waitUntilIdle().
   void processAll();
   // Returns when the queue is empty and no global BA runs.

@@ -130,6 +130,7 @@ struct EdgeClient::Impl {
     }
     session_id.store(reply.session_id());
     id_origin.store(static_cast<std::uint8_t>(reply.id_origin()));
+    id_floor.store(reply.id_floor());
     uplink += request.ByteSizeLong();
     downlink += reply.ByteSizeLong();
     return status;
@@ -267,6 +268,7 @@ struct EdgeClient::Impl {
         upload = std::move(queue.front());
         queue.pop_front();
         in_flight = true;
+        in_flight_keyframe = upload.keyframe.id;
         which = identify(upload);
       }
       v1::UploadKeyFrameRequest request;
@@ -325,6 +327,9 @@ struct EdgeClient::Impl {
       grpc::ClientContext context;
       authorize(context);
       context.set_deadline(deadlineIn(options.rpc_timeout));
+      // While the channel reconnects the call waits (within its deadline) instead of failing at
+      // once and sleeping a backoff: it goes out as soon as the server is back.
+      context.set_wait_for_ready(true);
       {
         std::lock_guard lock(mutex);
         if (stopping) return finishUpload(Outcome::kDiscarded, which);
@@ -340,10 +345,12 @@ struct EdgeClient::Impl {
         uplink += request.ByteSizeLong();
         downlink += reply.ByteSizeLong();
         backoff.reset();
+        reconnecting.store(false);
         return finishUpload(Outcome::kSent, which);
       }
       if (isStopping()) return finishUpload(Outcome::kDiscarded, which);
       if (status.error_code() == grpc::StatusCode::NOT_FOUND) {
+        reconnecting.store(true);
         if (reopenSession(session, "keyframe upload: " + status.error_message())) continue;
       } else if (isPermanent(status.error_code())) {
         spdlog::error("edge client: upload {} rejected: {}", request.upload().sequence(),
@@ -352,6 +359,7 @@ struct EdgeClient::Impl {
       }
       // Anything else (unreachable, deadline exceeded: perhaps after the server had it) is
       // retried; the server passes a retried sequence on once only.
+      reconnecting.store(true);
       ++upload_retries;
       if (sleepUnlessStopping(backoff.next())) return finishUpload(Outcome::kDiscarded, which);
     }
@@ -389,6 +397,7 @@ struct EdgeClient::Impl {
         if (!received) uplink += request.ByteSizeLong();
         received = true;
         backoff.reset();
+        reconnecting.store(false);
         downlink += message.ByteSizeLong();
         deliver(message);
       }
@@ -399,6 +408,11 @@ struct EdgeClient::Impl {
       }
       if (isStopping()) return;
       const grpc::StatusCode code = status.error_code();
+      // The stream breaks at once when the server goes: uploads would only notice at their
+      // deadline.
+      if (code == grpc::StatusCode::UNAVAILABLE || code == grpc::StatusCode::NOT_FOUND) {
+        reconnecting.store(true);
+      }
       if (code == grpc::StatusCode::NOT_FOUND) {
         if (reopenSession(session, "slice stream: " + status.error_message())) continue;
       } else if (code == grpc::StatusCode::OUT_OF_RANGE) {
@@ -447,6 +461,8 @@ struct EdgeClient::Impl {
 
   std::atomic<std::uint64_t> session_id{0};
   std::atomic<std::uint8_t> id_origin{0};
+  std::atomic<std::uint64_t> id_floor{0};
+  std::atomic<bool> reconnecting{false};
   std::mutex reopen_mutex;
   std::atomic<std::uint64_t> last_applied{0};
   std::atomic<bool> resync_pending{false};
@@ -458,6 +474,7 @@ struct EdgeClient::Impl {
   bool closed = false;
   std::deque<KeyFrameUpload> queue;
   bool in_flight = false;
+  KeyFrameId in_flight_keyframe = kInvalidId;
   std::uint64_t last_upload_sequence = 0;
   grpc::ClientContext* upload_context = nullptr;
   grpc::ClientContext* stream_context = nullptr;
@@ -491,6 +508,23 @@ std::uint64_t EdgeClient::sessionId() const {
 
 std::uint8_t EdgeClient::idOrigin() const {
   return impl_->id_origin.load();
+}
+
+std::uint64_t EdgeClient::idFloor() const {
+  return impl_->id_floor.load();
+}
+
+bool EdgeClient::reconnecting() const {
+  return impl_->reconnecting.load();
+}
+
+std::vector<KeyFrameId> EdgeClient::pendingUploadKeyFrames() const {
+  std::lock_guard lock(impl_->mutex);
+  std::vector<KeyFrameId> out;
+  out.reserve(impl_->queue.size() + 1);
+  if (impl_->in_flight) out.push_back(impl_->in_flight_keyframe);
+  for (const KeyFrameUpload& upload : impl_->queue) out.push_back(upload.keyframe.id);
+  return out;
 }
 
 std::uint64_t EdgeClient::uploadKeyFrame(KeyFrameUpload upload) {

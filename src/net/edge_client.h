@@ -10,6 +10,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "map/map_records.h"
 #include "net/wire_types.h"
@@ -103,6 +104,14 @@ class EdgeClient {
 
   std::uint64_t sessionId() const;
   std::uint8_t idOrigin() const;  // top byte for every id this client makes
+  // Ids of this origin the session's map already held when it opened (a map the edge loaded from
+  // its store): make ids above it. 0 = none.
+  std::uint64_t idFloor() const;
+  // The last upload attempt failed for want of the server (unreachable, or its session lost and
+  // not reopened yet); false again once an upload goes through.
+  bool reconnecting() const;
+  // Keyframes whose upload is queued or being sent (not yet acknowledged by the server).
+  std::vector<KeyFrameId> pendingUploadKeyFrames() const;
 
   // Queues a keyframe and returns at once with its sequence (the caller's when non-zero, else the
   // next one). acknowledged_slice is filled in with the last slice applied. A worker sends the

@@ -35,6 +35,9 @@ class EdgeSessionBackend {
   // The client lost its map (or the server lost its session): push a slice with full_resync set
   // as soon as possible.
   virtual void onFullResyncRequested() {}
+  // Ids of the session's id origin that its map already holds (a stored map loaded), up to this
+  // one; 0 = none. Told to the client when the session opens.
+  virtual std::uint64_t idFloor() const { return 0; }
 };
 
 class EdgeSessionFactory {

@@ -153,6 +153,10 @@ grpc::Status EdgeService::OpenSession(grpc::ServerContext* context,
   reply->set_id_origin(session->config.id_origin);
   reply->set_protocol_version(kWireProtocolVersion);
   reply->set_max_message_bytes(limits_.max_message_bytes);
+  {
+    std::lock_guard lock(session->backend_mutex);
+    reply->set_id_floor(session->backend->idFloor());
+  }
   session->uplink_bytes += request->ByteSizeLong();
   session->downlink_bytes += reply->ByteSizeLong();
   spdlog::info("edge server: session {:#x} opened for '{}' ({}, {}), id origin {}",

@@ -27,6 +27,7 @@ class SliceQueue final : public SliceSink {
   explicit SliceQueue(SliceQueueLimits limits = {});
 
   std::uint64_t push(MapSlice slice) override;
+  std::size_t maxSliceBytes() const override { return limits_.max_message_bytes; }
   std::uint64_t acknowledged() const override;
 
   // The client applied every slice up to `sequence`: they need not be kept any longer.

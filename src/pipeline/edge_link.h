@@ -3,6 +3,7 @@
 // over gRPC (the real split) and in-process (tests, no network).
 #include <cstdint>
 #include <functional>
+#include <vector>
 
 #include "client/keyframe_uplink.h"
 #include "map/ids.h"
@@ -30,6 +31,12 @@ class EdgeLink : public KeyFrameUplink {
 
   // The id origin byte the session gave this client (its map element ids start with it).
   virtual std::uint8_t idOrigin() const = 0;
+  // Ids of that origin the edge's map already held when the session opened (a stored map the
+  // edge resumed): the client makes its ids above. 0 = none.
+  virtual std::uint64_t idFloor() const { return 0; }
+  // Keyframes whose upload the link still holds (queued or being sent): after a full resync they
+  // are on their way, not lost.
+  virtual std::vector<KeyFrameId> pendingKeyFrames() const { return {}; }
   // Called on the link's own thread for every slice; set before the first upload.
   virtual void setSliceHandler(SliceHandler handler) = 0;
   // Set before the first upload. The default suits a link that never drops an upload.

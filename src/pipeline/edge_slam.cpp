@@ -6,6 +6,7 @@
 #include <cmath>
 #include <mutex>
 #include <thread>
+#include <unordered_set>
 
 #include "client/slice_applier.h"
 #include "semantic/label_encoding.h"
@@ -17,6 +18,8 @@ EdgeSlam::EdgeSlam(const PinholeCamera& camera, SlamOptions options, std::unique
     : TrackingSlam(camera, std::move(options), link->idOrigin()), link_(std::move(link)) {
   EdgeKeyFrameSinkOptions sink_options;
   sink_options.camera = camera_;
+  // The edge resumed a stored map holding ids of this origin: ours start above them.
+  if (link_->idFloor() != 0) map_.ids().advancePast(link_->idFloor());
   sink_ = std::make_unique<EdgeKeyFrameSink>(map_, *link_, sink_options);
   link_->setSliceHandler([this](MapSlice slice) { onSlice(std::move(slice)); });
   link_->setUploadDroppedHandler(
@@ -101,11 +104,20 @@ void EdgeSlam::onUploadDropped(std::uint64_t sequence, KeyFrameId keyframe) {
 
 void EdgeSlam::afterFrame() {
   std::vector<KeyFrameId> forgotten;
+  std::vector<KeyFrameId> resend;
   {
     std::lock_guard lock(stats_mutex_);
     forgotten.swap(forgotten_keyframes_);
+    resend.swap(keyframes_to_resend_);
   }
   if (!forgotten.empty()) tracker_->onMapWindowChanged(forgotten, {});
+  if (!resend.empty()) {
+    std::uint64_t resent = 0;
+    for (const KeyFrameId id : resend) resent += sink_->resendKeyFrame(id) ? 1 : 0;
+    spdlog::info("edge: {} keyframes the edge lacked after its restart uploaded again", resent);
+    std::lock_guard lock(stats_mutex_);
+    resync_.keyframes_resent += resent;
+  }
   {
     // Tracking adds keyframes and points between slices: the client map's peak is seen here.
     // Not worth waiting for a slice being applied (it notes the size itself when done).
@@ -168,6 +180,7 @@ void EdgeSlam::onSlice(MapSlice slice) {
       applied.keyframes_moved, applied.keyframes_evicted.size(), applied.points_evicted,
       applied.keyframes_entered.size(), apply_ms);
   const double latency_s = sink_->onSliceApplied(slice.upload_sequence, applied.frame_index);
+  if (slice.full_resync) onFullResync(applied.keyframes_edge_lacks);
   for (const MaskRecord& mask : slice.masks) offerMask(mask);
   std::lock_guard lock(stats_mutex_);
   ++slices_applied_;
@@ -180,6 +193,40 @@ void EdgeSlam::onSlice(MapSlice slice) {
   client_map_.keyframes_entered += applied.keyframes_entered.size();
   slice_apply_ms_.add(apply_ms);
   if (latency_s >= 0.0) slice_latency_ms_.add(latency_s * 1000.0);
+}
+
+void EdgeSlam::onFullResync(const std::vector<KeyFrameId>& edge_lacks) {
+  // Those still in the link's queue are on their way; the others the edge lost.
+  const std::vector<KeyFrameId> pending = link_->pendingKeyFrames();
+  const std::unordered_set<KeyFrameId> on_the_way(pending.begin(), pending.end());
+  std::vector<KeyFrameId> resend;
+  std::uint64_t lost_evicted = 0;
+  {
+    std::lock_guard lock(map_.updateMutex());
+    for (const KeyFrameId id : edge_lacks) {
+      const KeyFrame* keyframe = map_.keyFrame(id);
+      if (keyframe == nullptr || keyframe->isBad() || on_the_way.contains(id)) continue;
+      if (keyframe->isEvicted()) {
+        ++lost_evicted;
+      } else {
+        resend.push_back(id);
+      }
+    }
+  }
+  spdlog::warn(
+      "edge: full resync: the edge's map lacks {} of this client's keyframes: {} to upload again, "
+      "{} lost (evicted here before the edge stored them), {} still on their way",
+      edge_lacks.size(), resend.size(), lost_evicted,
+      edge_lacks.size() - resend.size() - lost_evicted);
+  std::lock_guard lock(stats_mutex_);
+  ++resync_.full_resyncs;
+  resync_.keyframes_lost_evicted += lost_evicted;
+  keyframes_to_resend_.insert(keyframes_to_resend_.end(), resend.begin(), resend.end());
+}
+
+ResyncCounters EdgeSlam::resyncCounters() const {
+  std::lock_guard lock(stats_mutex_);
+  return resync_;
 }
 
 void EdgeSlam::offerMask(const MaskRecord& mask) {

@@ -24,6 +24,16 @@ struct ClientMapSize {
   std::size_t keyframes_entered = 0;  // keyframes sent back into the window
 };
 
+// What full resyncs (a reconnection after the edge lost its session) did to the client's
+// keyframes: each one the client made is on the edge, re-sent, or lost for a reason counted here.
+struct ResyncCounters {
+  std::uint64_t full_resyncs = 0;      // slices with full_resync applied
+  std::uint64_t keyframes_resent = 0;  // the edge lacked them: uploaded again
+  // The edge lacked them and the client no longer had their features (evicted from its bounded
+  // map before the edge stored them): lost.
+  std::uint64_t keyframes_lost_evicted = 0;
+};
+
 class EdgeSlam : public TrackingSlam {
  public:
   // With `adaptation` and a networked link, a probing loop retunes the keyframe rules and the
@@ -44,6 +54,7 @@ class EdgeSlam : public TrackingSlam {
   std::size_t keyFrameCount() const override;
   std::size_t mapPointCount() const override;
   ClientMapSize clientMapSize() const;
+  ResyncCounters resyncCounters() const;
   // Points the client triangulated itself (monocular); read once the run is over.
   const KeyFrameTriangulationStats& clientTriangulation() const;
 
@@ -53,6 +64,7 @@ class EdgeSlam : public TrackingSlam {
   void onSlice(MapSlice slice);
   void onUploadDropped(std::uint64_t sequence, KeyFrameId keyframe);
   void offerMask(const MaskRecord& mask);
+  void onFullResync(const std::vector<KeyFrameId>& edge_lacks);
   void afterFrame() override;
   // --fast: until the edge has answered every keyframe upload (at most kMaxEdgeWaitS).
   void waitForEdge();
@@ -79,6 +91,9 @@ class EdgeSlam : public TrackingSlam {
   // Keyframes forgotten after their upload was dropped, for the tracker's relocalisation
   // database (told on the tracking thread, between frames).
   std::vector<KeyFrameId> forgotten_keyframes_;
+  // Keyframes a full resync found missing on the edge, re-sent on the tracking thread.
+  std::vector<KeyFrameId> keyframes_to_resend_;
+  ResyncCounters resync_;
 };
 
 }  // namespace edgeslam

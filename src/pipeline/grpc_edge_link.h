@@ -18,6 +18,11 @@ class GrpcEdgeLink : public EdgeLink {
 
   void send(KeyFrameUpload upload) override;
   std::uint8_t idOrigin() const override { return client_->idOrigin(); }
+  std::uint64_t idFloor() const override { return client_->idFloor(); }
+  bool reconnecting() const override { return client_->reconnecting(); }
+  std::vector<KeyFrameId> pendingKeyFrames() const override {
+    return client_->pendingUploadKeyFrames();
+  }
   void setSliceHandler(SliceHandler handler) override;
   void setUploadDroppedHandler(UploadDroppedHandler handler) override;
   EdgeLinkCounters counters() const override;

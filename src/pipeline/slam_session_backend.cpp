@@ -6,13 +6,19 @@
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 
+#include "net/slice_splitting.h"
 #include "net/wire_error.h"
 #include "pipeline/local_slam.h"
 #include "store/store_location.h"
+#include "store/stored_map_loader.h"
 #include "util/timing_stats.h"
 
 namespace edgeslam {
 namespace {
+
+// After a restart the edge's ids restart beyond the stored ones by this much: the last second of
+// ids before the restart (made, sent to the client, not stored) is never handed out again.
+constexpr std::uint64_t kEdgeIdGapAfterRestart = std::uint64_t{1} << 32;
 
 cv::Mat decodeImage(const std::vector<std::uint8_t>& bytes, int flags, const char* what) {
   if (bytes.empty()) return {};
@@ -45,49 +51,145 @@ SlamSessionBackend::SlamSessionBackend(const SessionConfig& config, SliceSink& s
       throw std::invalid_argument(std::string("no segmenter for this session: ") + e.what());
     }
   }
+  // A session naming a map the store holds resumes it (a client reconnecting after a restart):
+  // loaded now, so that the full resync the client asks for first carries it.
+  if (auto resumed = storedSessionToResume()) makeMapping(std::move(resumed));
 }
 
 SlamSessionBackend::~SlamSessionBackend() {
   if (mapping_) mapping_->stop();
   if (store_writer_) store_writer_->stop();
+  if (slices_split_.load() + slices_not_sent_.load() > 0) {
+    spdlog::info("session {}: {} slices split to fit a message, {} not sent", config_.session_id,
+                 slices_split_.load(), slices_not_sent_.load());
+  }
+}
+
+std::optional<StoredSession> SlamSessionBackend::storedSessionToResume() {
+  if (!options_.store || config_.map_name.empty() || config_.sensor == Sensor::kStereo) {
+    return std::nullopt;
+  }
+  std::optional<StoredMap> stored;
+  Stopwatch read_timer;
+  try {
+    stored = options_.store->loadMap(config_.map_name);
+  } catch (const std::exception& e) {
+    spdlog::error("session {}: map '{}' not loaded: {}", config_.session_id, config_.map_name,
+                  e.what());
+    return std::nullopt;
+  }
+  if (!stored) return std::nullopt;
+  // Each stored session is in its own frame: the latest one with keyframes is resumed.
+  for (auto it = stored->sessions.rbegin(); it != stored->sessions.rend(); ++it) {
+    if (it->keyframes.empty()) continue;
+    if (it->info.sensor != config_.sensor) {
+      spdlog::warn("session {}: map '{}' was made with a {} sensor: not resumed by a {} session",
+                   config_.session_id, config_.map_name, toString(it->info.sensor),
+                   toString(config_.sensor));
+      return std::nullopt;
+    }
+    spdlog::info("session {}: map '{}' read from {} in {:.0f} ms", config_.session_id,
+                 config_.map_name, options_.store->location(), read_timer.elapsedMs());
+    return std::move(*it);
+  }
+  return std::nullopt;
+}
+
+void SlamSessionBackend::publish(MapSlice slice) {
+  try {
+    const SlicePushResult pushed = pushSplitting(sink_, std::move(slice));
+    if (pushed.parts > 1) {
+      ++slices_split_;
+      spdlog::info("session {}: slice sent in {} parts (larger than one message)",
+                   config_.session_id, pushed.parts);
+    }
+  } catch (const std::exception& e) {
+    ++slices_not_sent_;
+    spdlog::error("session {}: slice not sent ({} so far): {}", config_.session_id,
+                  slices_not_sent_.load(), e.what());
+  }
+}
+
+void SlamSessionBackend::makeMapping(std::optional<StoredSession> resumed) {
+  std::lock_guard view_lock(view_mutex_);
+  EdgeMapSessionOptions mapping = options_.mapping;
+  mapping.mapper.observe_recent_points = true;
+  mapping.segmenter = segmenter_;
+  // The client bounds its map: the window follows its setting.
+  mapping.window.keyframes =
+      static_cast<std::size_t>(std::max(0, config_.settings.client_map_keyframes));
+  double rebuild_ms = 0.0;
+  std::vector<KeyFrameId> stored_keyframes;
+  if (resumed) {
+    mapping.preload = [&](Map& map) {
+      Stopwatch timer;
+      loadStoredSession(*resumed, map);
+      // Edge ids made after the last batch the store kept may still name elements a client
+      // holds: new ones start well beyond.
+      std::uint64_t newest_edge_id = 0;
+      for (const KeyFrameRecord& k : resumed->keyframes) {
+        stored_keyframes.push_back(k.id);
+        if (idOrigin(k.id) == config_.id_origin) id_floor_ = std::max(id_floor_, k.id);
+      }
+      for (const MapPointRecord& p : resumed->points) {
+        if (idOrigin(p.id) == 0) newest_edge_id = std::max(newest_edge_id, p.id);
+        if (idOrigin(p.id) == config_.id_origin) id_floor_ = std::max(id_floor_, p.id);
+      }
+      map.ids().advancePast(newest_edge_id + kEdgeIdGapAfterRestart);
+      rebuild_ms = timer.elapsedMs();
+    };
+  }
+  mapping_ =
+      std::make_unique<EdgeMapSession>(config_.camera, config_.sensor, mapping,
+                                       [this](MapSlice slice) { publish(std::move(slice)); });
+  if (resumed) {
+    const EdgeMapSessionStats loaded = mapping_->stats();
+    const std::size_t keyframes = std::max<std::size_t>(1, loaded.keyframes_loaded);
+    spdlog::info(
+        "session {}: map '{}' resumed: {} keyframes, {} points; rebuilt in {:.0f} ms, bags of "
+        "words {:.0f} ms ({:.1f} ms per keyframe)",
+        config_.session_id, config_.map_name, loaded.keyframes_loaded, resumed->points.size(),
+        rebuild_ms, loaded.load_describe_ms,
+        (rebuild_ms + loaded.load_describe_ms) / static_cast<double>(keyframes));
+  }
+  startStoreWriter(resumed ? std::optional<StoreSessionId>(resumed->id) : std::nullopt,
+                   stored_keyframes);
 }
 
 void SlamSessionBackend::onKeyFrame(KeyFrameUpload upload) {
-  if (!mapping_) {
-    std::lock_guard view_lock(view_mutex_);
-    EdgeMapSessionOptions mapping = options_.mapping;
-    mapping.mapper.observe_recent_points = true;
-    mapping.segmenter = segmenter_;
-    // The client bounds its map: the window follows its setting.
-    mapping.window.keyframes =
-        static_cast<std::size_t>(std::max(0, config_.settings.client_map_keyframes));
-    mapping_ = std::make_unique<EdgeMapSession>(
-        config_.camera, config_.sensor, mapping, [this](MapSlice slice) {
-          try {
-            sink_.push(std::move(slice));
-          } catch (const std::exception& e) {
-            spdlog::error("session {}: slice not sent: {}", config_.session_id, e.what());
-          }
-        });
-    startStoreWriter();
-  }
+  if (!mapping_) makeMapping(std::nullopt);
   mapping_->onKeyFrame(upload);
 }
 
-void SlamSessionBackend::startStoreWriter() {
+void SlamSessionBackend::onFullResyncRequested() {
+  // A session with nothing mapped yet (no stored map to resume) answers with an empty map: the
+  // client then sends again every keyframe it holds.
+  if (!mapping_) makeMapping(std::nullopt);
+  mapping_->publishFullResync();
+}
+
+void SlamSessionBackend::startStoreWriter(std::optional<StoreSessionId> resumed,
+                                          const std::vector<KeyFrameId>& stored_keyframes) {
   if (!options_.store) return;
   const std::string map =
       !config_.map_name.empty()
           ? config_.map_name
           : defaultMapName(config_.client_name + "-s" + std::to_string(config_.session_id));
   try {
-    const StoreSessionId session =
-        options_.store->beginSession(map, {config_.client_name, config_.camera, config_.sensor});
+    StoreSessionId session = 0;
+    if (resumed) {
+      session = *resumed;
+      options_.store->resumeSession(session);
+    } else {
+      session =
+          options_.store->beginSession(map, {config_.client_name, config_.camera, config_.sensor});
+    }
     store_writer_ = std::make_unique<MapStoreWriter>(options_.store, session, mapping_->map(),
                                                      options_.store_stats);
+    store_writer_->assumeStored(stored_keyframes);
     mapping_->setChangeObserver(store_writer_.get());
-    spdlog::info("session {}: writing map '{}' to {}", config_.session_id, map,
-                 options_.store->location());
+    spdlog::info("session {}: writing map '{}' to {}{}", config_.session_id, map,
+                 options_.store->location(), resumed ? " (resumed)" : "");
   } catch (const std::exception& e) {
     // The session still maps; only its persistence is lost, and said so.
     spdlog::error("session {}: map '{}' not stored: {}", config_.session_id, map, e.what());

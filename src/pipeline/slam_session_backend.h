@@ -1,6 +1,7 @@
 #pragma once
 // What an edge server session does: in edge mode it keeps the client's global map (keyframe
 // uploads in, map slices out); in offload mode it runs the whole SLAM on the frames it is sent.
+#include <atomic>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -30,6 +31,10 @@ class SlamSessionBackend : public EdgeSessionBackend {
 
   void onKeyFrame(KeyFrameUpload upload) override;
   std::optional<OffloadResult> onFrame(OffloadFrame frame) override;
+  // Edge mode: a slice with full_resync (every keyframe's pose and every point), split when
+  // larger than a message.
+  void onFullResyncRequested() override;
+  std::uint64_t idFloor() const override { return id_floor_; }
 
   // For a viewer, from any thread: the session's map now (its global map in edge mode, the
   // offloaded SLAM's map in offload mode; empty before the first keyframe or frame) and the loops
@@ -38,7 +43,12 @@ class SlamSessionBackend : public EdgeSessionBackend {
   std::size_t loops() const;
 
  private:
-  void startStoreWriter();
+  // The map's latest stored session with keyframes, when the session names a stored map.
+  std::optional<StoredSession> storedSessionToResume();
+  void makeMapping(std::optional<StoredSession> resumed);
+  void startStoreWriter(std::optional<StoreSessionId> resumed,
+                        const std::vector<KeyFrameId>& stored_keyframes);
+  void publish(MapSlice slice);
 
   mutable std::mutex view_mutex_;  // guards making mapping_ and offload_, for the viewer
   SessionConfig config_;
@@ -48,6 +58,9 @@ class SlamSessionBackend : public EdgeSessionBackend {
   std::unique_ptr<MapStoreWriter> store_writer_;  // outlives mapping_, which it observes
   std::unique_ptr<EdgeMapSession> mapping_;       // edge mode, made at the first keyframe
   std::unique_ptr<SlamSystem> offload_;           // offload mode, made at the first frame
+  std::uint64_t id_floor_ = 0;
+  std::atomic<std::uint64_t> slices_split_{0};     // slices sent as several parts
+  std::atomic<std::uint64_t> slices_not_sent_{0};  // slices that could not be sent (logged)
 };
 
 class SlamSessionFactory : public EdgeSessionFactory {

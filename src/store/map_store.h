@@ -86,6 +86,8 @@ class MapStore {
   // In one transaction; throws StoreError, leaving the store as it was.
   virtual void write(StoreSessionId session, const MapStoreBatch& batch) = 0;
   virtual void endSession(StoreSessionId session) = 0;
+  // A stored session written to again (a server resuming it after a restart): open again.
+  virtual void resumeSession(StoreSessionId session) = 0;
   virtual bool removeMap(const std::string& name) = 0;
 };
 

@@ -63,6 +63,11 @@ MapStoreWriter::~MapStoreWriter() {
   stop();
 }
 
+void MapStoreWriter::assumeStored(const std::vector<KeyFrameId>& keyframes) {
+  std::lock_guard writing(write_mutex_);
+  stored_keyframes_.insert(keyframes.begin(), keyframes.end());
+}
+
 void MapStoreWriter::onMapCleared() {
   std::lock_guard lock(pending_mutex_);
   cleared_ = true;

@@ -61,6 +61,10 @@ class MapStoreWriter : public MapChangeObserver {
   void onMapChanged(const MapChanges& changes) override;
   void onMasks(const std::vector<MaskRecord>& masks) override;
 
+  // The session resumes a stored one: these keyframes are in the store already (later changes
+  // update their poses or delete them instead of writing them whole). Call before any change.
+  void assumeStored(const std::vector<KeyFrameId>& keyframes);
+
   // Writes what is pending now (on the caller's thread) and waits for it.
   void flush();
   // Writes the rest, marks the session ended and stops the thread. Call before the map goes.

@@ -418,6 +418,11 @@ void SqliteMapStore::endSession(StoreSessionId session) {
   statements_->end_session.bind(1, nowSeconds()).bind(2, session).run();
 }
 
+void SqliteMapStore::resumeSession(StoreSessionId session) {
+  std::lock_guard lock(mutex_);
+  statements_->end_session.bind(1, 0.0).bind(2, session).run();
+}
+
 bool SqliteMapStore::removeMap(const std::string& name) {
   std::lock_guard lock(mutex_);
   const auto id = mapId(name);

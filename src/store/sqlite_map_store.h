@@ -23,6 +23,7 @@ class SqliteMapStore : public MapStore {
   StoreSessionId beginSession(const std::string& map, const StoredSessionInfo& info) override;
   void write(StoreSessionId session, const MapStoreBatch& batch) override;
   void endSession(StoreSessionId session) override;
+  void resumeSession(StoreSessionId session) override;
   bool removeMap(const std::string& name) override;
 
  private:

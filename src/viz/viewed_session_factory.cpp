@@ -24,6 +24,7 @@ class ViewedSession : public EdgeSessionBackend {
     return backend_->onFrame(std::move(frame));
   }
   void onFullResyncRequested() override { backend_->onFullResyncRequested(); }
+  std::uint64_t idFloor() const override { return backend_->idFloor(); }
 
  private:
   std::shared_ptr<EdgeSessionBackend> backend_;

@@ -137,6 +137,45 @@ TEST(MapStore, LaterBatchesUpdatePosesAndEraseWhatTheMapErased) {
   std::filesystem::remove_all(dir);
 }
 
+// A server restarted on its store resumes a session: the map loaded back, written on into the
+// same stored session; a loaded keyframe culled later is deleted, not left behind.
+TEST(MapStore, ResumedSessionIsWrittenOnInPlace) {
+  const auto dir = freshStoreDir("resume");
+  SmallMap small;
+  std::shared_ptr<MapStore> store = openMapStore(dir, MapStoreAccess::kServe);
+  const StoreSessionId session = store->beginSession("m", small.info());
+  {
+    MapStoreWriter writer(store, session, small.map, nullptr);
+    std::lock_guard lock(small.map.updateMutex());
+    writer.onMapChanged(small.map.takeChanges());
+  }  // stopped: written, session ended
+  const StoredSession stored = onlySession(*store->loadMap("m"));
+  EXPECT_GT(stored.ended, 0.0);
+  Map resumed;
+  loadStoredSession(stored, resumed);
+  store->resumeSession(stored.id);
+  EXPECT_EQ(onlySession(*store->loadMap("m")).ended, 0.0);
+  MapStoreWriter writer(store, stored.id, resumed, nullptr);
+  std::vector<KeyFrameId> ids;
+  for (const KeyFrameRecord& k : stored.keyframes) ids.push_back(k.id);
+  writer.assumeStored(ids);
+  {
+    std::lock_guard lock(resumed.updateMutex());
+    KeyFrame* culled = resumed.keyFrame(stored.keyframes[1].id);
+    ASSERT_NE(culled, nullptr);
+    resumed.eraseKeyFrame(culled);
+    writer.onMapChanged(resumed.takeChanges());
+  }
+  writer.stop();
+  const StoredMap after = *store->loadMap("m");
+  const StoredSession& again = onlySession(after);
+  EXPECT_EQ(again.id, stored.id);
+  ASSERT_EQ(again.keyframes.size(), 2u);
+  for (const KeyFrameRecord& k : again.keyframes) EXPECT_NE(k.id, stored.keyframes[1].id);
+  EXPECT_GT(again.ended, 0.0);
+  std::filesystem::remove_all(dir);
+}
+
 TEST(MapStore, NamedMapsLiveSideBySideAndRemoveAlone) {
   const auto dir = freshStoreDir("named");
   SmallMap small;
