@@ -1,5 +1,6 @@
 #include "map_store_option.h"
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <stdexcept>
@@ -70,6 +71,15 @@ nlohmann::json storeMetrics(const MapStoreChoice& choice, const std::string& nam
     out["bytes_per_keyframe"] = info->keyframes > 0 ? info->bytes / info->keyframes : 0;
   }
   return out;
+}
+
+std::string storeWarning(const nlohmann::json& store_metrics, std::size_t keyframes) {
+  if (!store_metrics.is_object() || store_metrics.value("failures", 0) == 0) return {};
+  return fmt::format(
+      "map store: {} write batch(es) failed (disk full or unwritable? see the errors above); the "
+      "stored map '{}' holds {} of this run's {} keyframes",
+      store_metrics.value("failures", 0), store_metrics.value("map", std::string()),
+      store_metrics.value("keyframes", 0), keyframes);
 }
 
 }  // namespace edgeslam::cli

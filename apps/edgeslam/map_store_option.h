@@ -29,4 +29,8 @@ void addMapsOption(CLI::App* command, std::string& maps);
 // metrics.json's "store" block for the map `name`: what the writers wrote and the map's size.
 nlohmann::json storeMetrics(const MapStoreChoice& choice, const std::string& name);
 
+// The run's warning when writes to the store failed ("" when none did): how many, and what the
+// stored map holds of the run's `keyframes`.
+std::string storeWarning(const nlohmann::json& store_metrics, std::size_t keyframes);
+
 }  // namespace edgeslam::cli

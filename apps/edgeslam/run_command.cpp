@@ -411,7 +411,7 @@ int runPipeline(const RunOptions& given) {
 
   const SlamCounters counters = slam.counters();
   const std::optional<TrackingDiagnostics> diagnostics = slam.trackingDiagnostics();
-  const std::vector<std::string> warnings =
+  std::vector<std::string> warnings =
       runWarnings({.frames = frame_count,
                    .tracked = tracked,
                    .lost = lost,
@@ -425,6 +425,10 @@ int runPipeline(const RunOptions& given) {
                    .frames_without_map = diagnostics ? diagnostics->frames_without_map : 0,
                    .map_built = !diagnostics || diagnostics->initialized_at_frame.has_value(),
                    .refusals = diagnostics ? refusalSummary(*diagnostics) : std::string()});
+  if (std::string store_warning = storeWarning(store_metrics, slam.keyFrameCount());
+      !store_warning.empty()) {
+    warnings.push_back(std::move(store_warning));
+  }
   const std::size_t keyframes_uploaded = std::max<std::size_t>(1, counters.keyframes_uploaded);
   nlohmann::json metrics = {{"frames", frame_count},
                             {"tracked", tracked},

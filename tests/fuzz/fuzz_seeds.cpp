@@ -142,6 +142,36 @@ int main(int argc, char** argv) {
   toProto(result, &reply);
   writeSeed("fuzz_offload_reply", "lost", reply);
 
+  // Service calls: a selector byte (fuzz_service_calls.cpp), then the request. Session id 0 is the
+  // harness's open session.
+  const auto call = [](char selector, const google::protobuf::MessageLite& request) {
+    return std::string(1, selector) + request.SerializeAsString();
+  };
+  writeSeed("fuzz_service_calls", "open", call(0, open));
+  v1::CloseSessionRequest close;
+  close.mutable_header()->set_protocol_version(kWireProtocolVersion);
+  writeSeed("fuzz_service_calls", "close", call(1, close));
+  {
+    v1::UploadKeyFrameRequest upload;
+    upload.mutable_header()->set_protocol_version(kWireProtocolVersion);
+    toProto(test::sampleUpload(1, 40, 5, rng), upload.mutable_upload());
+    writeSeed("fuzz_service_calls", "upload", call(2, upload));
+  }
+  v1::ProbeRequest probe;
+  probe.mutable_header()->set_protocol_version(kWireProtocolVersion);
+  probe.set_reply_bytes(512);
+  probe.set_payload(std::string(256, 'x'));
+  writeSeed("fuzz_service_calls", "probe", call(3, probe));
+  offload.mutable_header()->set_protocol_version(kWireProtocolVersion);
+  offload.mutable_header()->set_session_id(0);
+  writeSeed("fuzz_service_calls", "offload", call(4, offload));
+  v1::StreamSlicesRequest stream;
+  stream.mutable_header()->set_protocol_version(kWireProtocolVersion);
+  stream.set_from_sequence(1);
+  writeSeed("fuzz_service_calls", "stream", call(5, stream));
+  stream.set_want_full_resync(true);
+  writeSeed("fuzz_service_calls", "resync", call(5, stream));
+
   // Images: the headers and a little of what follows.
   writeSeed("fuzz_image_header", "grey.jpg", bytesOf(jpeg).substr(0, 4096));
   writeSeed("fuzz_image_header", "colour.jpg", bytesOf(colour_jpeg).substr(0, 4096));

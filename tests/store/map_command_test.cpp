@@ -3,9 +3,11 @@
 // store is one line naming the file.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -253,6 +255,54 @@ TEST(MapCommand, DamagedStoreIsOneLineNamingTheFile) {
   EXPECT_NE(usage.exit_code, 0) << usage.output;
   EXPECT_NE(usage.exit_code, 1) << usage.output;
   std::filesystem::remove_all(store);
+}
+
+// A store that cannot grow (the file size limit of the process, as a full disk would stop it):
+// the run goes on and tracks every frame, the failed writes are counted and warned about, and the
+// store still opens with what was written before.
+TEST(MapCommand, StoreThatCannotGrowCostsTheRunNothingButIsReported) {
+  EDGESLAM_REQUIRE_SHARED(kSequence);
+  if (std::system("prlimit --version > /dev/null 2>&1") != 0) {
+    GTEST_SKIP() << "prlimit (util-linux) is not installed";
+  }
+  const auto store = tempDir("full_store");
+  const auto out = tempDir("full_out");
+  // SIGXFSZ ignored, as a server under systemd would: writes past the limit fail with EFBIG.
+  const std::string command = "trap '' XFSZ; exec prlimit --fsize=2097152 " +
+                              test::edgeslamBinary().string() + " run --dataset " +
+                              test::sharedPath(kSequence).string() +
+                              " --mode edge --sensor rgbd --max-frames 300 --vocab none --maps " +
+                              store.string() + " --map full --out " + out.string() + " 2>&1";
+  std::string output;
+  FILE* pipe = popen(command.c_str(), "r");
+  ASSERT_NE(pipe, nullptr);
+  char buffer[4096];
+  while (const std::size_t n = fread(buffer, 1, sizeof(buffer), pipe)) output.append(buffer, n);
+  const int status = pclose(pipe);
+  ASSERT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << output;
+
+  std::ifstream metrics_file(out / "metrics.json");
+  const auto metrics = nlohmann::json::parse(metrics_file, nullptr, false);
+  ASSERT_TRUE(metrics.is_object()) << output;
+  EXPECT_GE(metrics["tracked"].get<double>(), 0.95 * metrics["frames"].get<double>());
+  const auto& stored = metrics["store"];
+  EXPECT_GE(stored["failures"].get<int>(), 1) << stored.dump();
+  EXPECT_LT(stored["keyframes"].get<int>(), metrics["keyframes"].get<int>()) << stored.dump();
+  bool warned = false;
+  for (const auto& warning : metrics["warnings"]) {
+    warned |= warning.get<std::string>().find("map store:") != std::string::npos;
+  }
+  EXPECT_TRUE(warned) << metrics["warnings"].dump();
+  EXPECT_NE(output.find("map store: "), std::string::npos) << output;
+
+  // Without the limit the store opens, whole, with the keyframes written before it filled up
+  // (how many depends on how fast the run fills the first batches).
+  const auto info = test::runEdgeslam("map info full --json --maps " + store.string(), false);
+  ASSERT_EQ(info.exit_code, 0) << info.output;
+  const auto summary = jsonOf(info);
+  EXPECT_EQ(summary["keyframes"], stored["keyframes"]);
+  std::filesystem::remove_all(store);
+  std::filesystem::remove_all(out);
 }
 
 }  // namespace
