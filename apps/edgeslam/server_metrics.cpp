@@ -5,25 +5,9 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "util/resident_memory.h"
+
 namespace edgeslam {
-namespace {
-
-// Resident memory of this process (kB from /proc), 0 where unknown.
-std::uint64_t residentBytes() {
-  std::ifstream in("/proc/self/status");
-  std::string key;
-  while (in >> key) {
-    if (key == "VmRSS:") {
-      std::uint64_t kb = 0;
-      in >> kb;
-      return kb * 1024;
-    }
-    in.ignore(1 << 12, '\n');
-  }
-  return 0;
-}
-
-}  // namespace
 
 nlohmann::json serverMetricsJson(const EdgeServer& server, double uptime_s) {
   nlohmann::json open = nlohmann::json::array();

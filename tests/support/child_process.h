@@ -15,6 +15,8 @@
 #include <thread>
 #include <vector>
 
+#include "util/resident_memory.h"
+
 namespace edgeslam::test {
 
 class ChildProcess {
@@ -83,18 +85,7 @@ class ChildProcess {
     return false;
   }
   // Resident memory in bytes (0 once the process has gone).
-  std::size_t residentBytes() const {
-    std::ifstream in("/proc/" + std::to_string(pid_) + "/status");
-    std::string key;
-    while (in >> key) {
-      if (key == "VmRSS:") {
-        std::size_t kb = 0;
-        in >> kb;
-        return kb * 1024;
-      }
-    }
-    return 0;
-  }
+  std::size_t residentBytes() const { return edgeslam::residentBytes(pid_); }
 
  private:
   std::filesystem::path log_;
