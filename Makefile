@@ -61,7 +61,7 @@ sanitize-build: deps
 	@cmake --build $(ASAN_DIR) -j $(JOBS) --target unit-tests edgeslam_fuzzers
 
 test-sanitize: sanitize-build
-	@cd $(ASAN_DIR) && ctest --output-on-failure -j $(JOBS) -L unit --timeout 900 -E "$(CLANG_NUMERIC_TESTS)"
+	@cd $(ASAN_DIR) && ctest --output-on-failure -j $(JOBS) -L unit --timeout 900
 
 # The clang build: -Wthread-safety checks the lock annotations at compile time (warnings are
 # errors), and ThreadSanitizer watches the unit tests run. -O1 with line tables only keeps it quick.
@@ -71,11 +71,7 @@ test-tsan: deps
 	  -DEDGESLAM_TSAN=ON -DEDGESLAM_BUILD_BENCH=OFF -DEDGESLAM_SHARED_DIR=$(EDGESLAM_SHARED) > /dev/null
 	@cmake --build $(TSAN_DIR) -j $(JOBS) --target unit-tests
 	@cd $(TSAN_DIR) && TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$(CURDIR)/tests/tsan.supp" \
-	  ctest --output-on-failure -j $(JOBS) -L unit --timeout 900 -E "$(CLANG_NUMERIC_TESTS)"
-
-# Single-threaded numeric tests whose results differ in the clang -O1 build (they pass in the gcc
-# builds; the cause, compiler or undefined behaviour, is not found yet: docs/status.md).
-CLANG_NUMERIC_TESTS := LocalMapperBow.DescribesKeyFramesAndTriangulatesThroughTheDirectIndex|PoseOptimizer.StereoObservationsImproveDepth|IntrinsicsRefinement.RecoversFocalLengthAndRadialDistortion
+	  ctest --output-on-failure -j $(JOBS) -L unit --timeout 900
 
 test: test-release
 	@if [ -n "$$CI" ]; then $(MAKE) --no-print-directory test-sanitize fuzz test-tsan; fi

@@ -130,6 +130,9 @@ std::vector<BadInvocation> sweep(const BadInputs& in) {
       {"run --dataset " + tum + " --mode bogus", kUsage},
       {"run --dataset " + tum + " --features -3", kUsage},
       {"run --dataset " + tum + " --features many", kUsage},
+      {"run --dataset " + tum + " --frames 10-5", kUsage},
+      {"run --dataset " + tum + " --frames ten", kUsage},
+      {"run --dataset " + tum + " --frames 5-500", kUsage},  // past the dataset's 20 frames
       {"run --dataset " + tum + " --realtime --fast", kUsage},
       {"run --dataset " + tum + " --format tiff", kUsage},
       {"run --dataset " + tum + " --sensor lidar", kUsage},

@@ -47,7 +47,12 @@ class SyntheticScene {
     std::uniform_real_distribution<double> xy(-1.5, 1.5), z(2.0, 4.0);
     std::uniform_int_distribution<int> byte(0, 255);
     for (int i = 0; i < count; ++i) {
-      points_.emplace_back(xy(rng_), xy(rng_), z(rng_));
+      // Drawn last coordinate first, the order this scene was tuned with (gcc evaluates call
+      // arguments right to left, clang left to right): every compiler draws the same scene.
+      const double pz = z(rng_);
+      const double py = xy(rng_);
+      const double px = xy(rng_);
+      points_.emplace_back(px, py, pz);
       std::array<std::uint8_t, 32> d{};
       for (auto& b : d) b = static_cast<std::uint8_t>(byte(rng_));
       descriptors_.push_back(d);
@@ -68,8 +73,11 @@ class SyntheticScene {
       const Eigen::Vector3d pc = T_cw * points_[p];
       const auto px = camera_.project(pc);
       if (!px || px->x() < 5 || px->y() < 5 || px->x() > 634 || px->y() > 474) continue;
-      cv::KeyPoint kp(static_cast<float>(px->x()) + noise(rng_),
-                      static_cast<float>(px->y()) + noise(rng_), 31.f, 45.f + noise(rng_), 20.f, 0);
+      const float angle_noise = noise(rng_);  // last argument first, as above
+      const float y_noise = noise(rng_);
+      const float x_noise = noise(rng_);
+      cv::KeyPoint kp(static_cast<float>(px->x()) + x_noise, static_cast<float>(px->y()) + y_noise,
+                      31.f, 45.f + angle_noise, 20.f, 0);
       features->keypoints.push_back(kp);
       auto d = descriptors_[p];
       for (int f = 0; f < flipped_bits; ++f) {

@@ -33,8 +33,11 @@ inline Eigen::Vector3d randomVisiblePoint(const SE3d& T_cw, std::mt19937& rng,
   std::uniform_real_distribution<double> v(cam.cy - half_window, cam.cy + half_window);
   std::uniform_real_distribution<double> d(min_depth, max_depth);
   const double depth = d(rng);
-  const Eigen::Vector3d pc((u(rng) - cam.cx) / cam.fx * depth, (v(rng) - cam.cy) / cam.fy * depth,
-                           depth);
+  // Drawn last coordinate first, the order these scenes were tuned with (gcc evaluates call
+  // arguments right to left, clang left to right): every compiler draws the same scene.
+  const double pv = v(rng);
+  const double pu = u(rng);
+  const Eigen::Vector3d pc((pu - cam.cx) / cam.fx * depth, (pv - cam.cy) / cam.fy * depth, depth);
   return T_cw.inverse() * pc;
 }
 
@@ -42,8 +45,14 @@ inline Eigen::Vector3d randomVisiblePoint(const SE3d& T_cw, std::mt19937& rng,
 // applied on the left.
 inline SE3d perturb(const SE3d& pose, double distance, double angle_rad, std::mt19937& rng) {
   std::normal_distribution<double> n(0.0, 1.0);
-  const Eigen::Vector3d axis = Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized();
-  const Eigen::Vector3d dir = Eigen::Vector3d(n(rng), n(rng), n(rng)).normalized();
+  const auto draw = [&] {  // last coordinate first, as in randomVisiblePoint
+    const double z = n(rng);
+    const double y = n(rng);
+    const double x = n(rng);
+    return Eigen::Vector3d(x, y, z);
+  };
+  const Eigen::Vector3d axis = draw().normalized();
+  const Eigen::Vector3d dir = draw().normalized();
   return SE3d(so3Exp(axis * angle_rad), dir * distance) * pose;
 }
 
