@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "support/edgeslam_command.h"
+#include "support/fresh_temp_dir.h"
 #include "support/shared_data.h"
 
 namespace edgeslam {
@@ -24,10 +25,7 @@ namespace {
 constexpr const char* kSequence = "datasets/7scenes-redkitchen-1000";
 
 std::filesystem::path tempDir(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("edgeslam_map_command_" + name + "_" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
-  return dir;
+  return test::freshTempDir("map_command_" + name);
 }
 
 std::size_t dataLineCount(const std::filesystem::path& file) {

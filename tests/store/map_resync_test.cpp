@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "support/edgeslam_command.h"
+#include "support/fresh_temp_dir.h"
 #include "support/shared_data.h"
 
 namespace edgeslam {
@@ -25,10 +26,7 @@ namespace {
 constexpr const char* kSequence = "datasets/7scenes-redkitchen-1000";
 
 std::filesystem::path tempDir(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("edgeslam_map_resync_" + name + "_" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
-  return dir;
+  return test::freshTempDir("map_resync_" + name);
 }
 
 int startInBackground(const std::string& arguments, const std::filesystem::path& log) {

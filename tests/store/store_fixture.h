@@ -10,14 +10,12 @@
 #include "map/synthetic_views.h"
 #include "store/map_store.h"
 #include "store/map_store_writer.h"
+#include "support/fresh_temp_dir.h"
 
 namespace edgeslam::test {
 
 inline std::filesystem::path freshStoreDir(const std::string& name) {
-  const auto dir = std::filesystem::temp_directory_path() /
-                   ("edgeslam_store_" + name + "_" + std::to_string(::getpid()));
-  std::filesystem::remove_all(dir);
-  return dir;
+  return freshTempDir("store_" + name);
 }
 
 struct SmallMap {
