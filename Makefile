@@ -79,9 +79,11 @@ test: test-release
 # libFuzzer harnesses (tests/fuzz), from the sanitizer build, each run for FUZZ_SECONDS on a corpus
 # kept in $(ASAN_DIR)/fuzz-corpus, seeded from real messages and files; prints executions per
 # harness and fails on any crash (the input is saved in $(ASAN_DIR)/fuzz-crashes).
+# A campaign of a million executions each: make fuzz FUZZ_RUNS=1000000 FUZZ_SECONDS=7200
 FUZZ_SECONDS ?= 20
+FUZZ_RUNS ?= -1
 fuzz: sanitize-build
-	@FUZZ_DIR=$(ASAN_DIR) FUZZ_SECONDS=$(FUZZ_SECONDS) bash scripts/fuzz.sh
+	@FUZZ_DIR=$(ASAN_DIR) FUZZ_SECONDS=$(FUZZ_SECONDS) FUZZ_RUNS=$(FUZZ_RUNS) bash scripts/fuzz.sh
 
 demo: vocab
 	@./$(BUILD_DIR)/edgeslam run --dataset "$(EDGESLAM_DATA)" --mode edge --out $(DEMO_OUT) $(DEMO_ARGS)

@@ -2,9 +2,12 @@
 # Runs every libFuzzer harness of $FUZZ_DIR for $FUZZ_SECONDS seconds (`make fuzz`), on a corpus
 # that grows across runs, seeded from real messages and files (fuzz_seeds, rewritten each run). Prints the
 # executions of each; exits 1 when a harness found a crash (its input is in fuzz-crashes/).
+# FUZZ_RUNS=N stops each harness after N executions instead (a campaign: FUZZ_SECONDS is then the
+# most each may take).
 set -uo pipefail
 FUZZ_DIR=${FUZZ_DIR:-build-asan}
 FUZZ_SECONDS=${FUZZ_SECONDS:-20}
+FUZZ_RUNS=${FUZZ_RUNS:--1}
 SHARED=${EDGESLAM_SHARED:-$(cd "$(dirname "$0")/../.." && pwd)/shared}
 seeds="$FUZZ_DIR/fuzz-seeds"
 rm -rf "$seeds"
@@ -22,7 +25,7 @@ for harness in "$FUZZ_DIR"/tests/fuzz/fuzz_*; do
   max_len=65536
   [ "$name" = fuzz_map_store ] && max_len=262144  # a whole (small) database file
   timeout -k 10 $((FUZZ_SECONDS + 120)) "$harness" "$corpus" "$seeds/$name" \
-    -max_total_time="$FUZZ_SECONDS" -max_len=$max_len -timeout=10 -rss_limit_mb=2048 \
+    -max_total_time="$FUZZ_SECONDS" -runs="$FUZZ_RUNS" -max_len=$max_len -timeout=10 -rss_limit_mb=2048 \
     -print_final_stats=1 -artifact_prefix="$FUZZ_DIR/fuzz-crashes/$name-" >"$log" 2>&1
   status=$?
   executions=$(grep -o 'stat::number_of_executed_units: *[0-9]*' "$log" | grep -o '[0-9]*$' | tail -1)
