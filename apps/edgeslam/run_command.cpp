@@ -296,6 +296,7 @@ int runPipeline(const RunOptions& given) {
   Stopwatch wall;
   Trajectory ground_truth;
   std::size_t tracked = 0, lost = 0, frames_dropped_late = 0;
+  std::size_t tracked_in_discarded_maps = 0, resets_seen = 0;
   FrameOrderGuard frame_order;
   std::optional<SemanticEvaluation> semantic_eval = SemanticEvaluation::open(info.path);
   if (semantic_eval) spdlog::info("ground-truth masks found: scoring the semantic culling");
@@ -369,6 +370,12 @@ int runPipeline(const RunOptions& given) {
       ++tracked;
     } else if (result.state == TrackingState::kLost) {
       ++lost;
+    }
+    if (slam.mapResets() != resets_seen) {
+      // A reset withdraws every pose of the map it discards: they leave `tracked`.
+      resets_seen = slam.mapResets();
+      tracked_in_discarded_maps += tracked;
+      tracked = 0;
     }
     const double fps = static_cast<double>(i + 1) / std::max(1e-9, wall.elapsedMs() / 1000.0);
     const std::size_t keyframes = slam.keyFrameCount();
@@ -456,6 +463,7 @@ int runPipeline(const RunOptions& given) {
                             {"tracking_recoveries", slam.trackingRecoveries()},
                             {"keyframe_decisions", keyFrameDecisionsJson(slam.keyFrameDecisions())},
                             {"map_resets", slam.mapResets()},
+                            {"tracked_in_discarded_maps", tracked_in_discarded_maps},
                             {"mode", mode},
                             {"requested_mode", options.mode},
                             {"sensor", sensor_name},
@@ -561,8 +569,11 @@ int runPipeline(const RunOptions& given) {
   fmt::print("\nSummary\n");
   fmt::print("  dataset      {} ({})\n", info.path.string(), toString(info.format));
   fmt::print("  mode/sensor  {} / {}\n", mode, sensor_name);
-  fmt::print("  frames       {} in {:.2f} s ({:.1f} fps), tracked {}, lost {}\n", frame_count,
-             seconds, static_cast<double>(frame_count) / std::max(seconds, 1e-9), tracked, lost);
+  fmt::print("  frames       {} in {:.2f} s ({:.1f} fps), tracked {}, lost {}{}\n", frame_count,
+             seconds, static_cast<double>(frame_count) / std::max(seconds, 1e-9), tracked, lost,
+             tracked_in_discarded_maps == 0
+                 ? std::string()
+                 : fmt::format(" ({} more tracked in a discarded map)", tracked_in_discarded_maps));
   fmt::print(
       "  map          {} keyframes, {} points, {} relocalisations, {} recoveries, {} resets\n",
       slam.keyFrameCount(), slam.mapPointCount(), slam.relocalizations(), slam.trackingRecoveries(),

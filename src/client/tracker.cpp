@@ -179,7 +179,8 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
       if (sink_ != nullptr) sink_->onMapReset();
       resetMap();
       record(frame, false);
-      result.state = state_;
+      // This frame was lost (and counted so); the next one starts the new map.
+      result.state = TrackingState::kLost;
       return result;
     }
   }
