@@ -243,6 +243,17 @@ int runPipeline(const RunOptions& given) {
     slam_options.mapper.triangulation_search =
         *parseTriangulationSearch(*options.triangulation_search);
   }
+  if (options.deterministic) {
+    if (mode != "local") {
+      throw CLI::ValidationError("--deterministic",
+                                 "applies to --mode local only (edge and offload runs cross "
+                                 "processes or threads that are not in lock-step)");
+    }
+    // The back end runs inside the tracking thread, after each frame; OpenCV's pool stays out of
+    // feature extraction so nothing depends on the order threads finish in.
+    slam_options.threaded_mapping = false;
+    cv::setNumThreads(1);
+  }
   if (options.refine_intrinsics && mode != "local") {
     spdlog::warn("--refine-intrinsics applies to --mode local only; the {} run keeps the camera",
                  mode);
@@ -471,6 +482,7 @@ int runPipeline(const RunOptions& given) {
                             {"dataset_frames", frameRangeJson(options.frames, frame_count)},
                             {"wall_s", seconds},
                             {"pacing", options.realtime ? "realtime" : "fast"},
+                            {"deterministic", options.deterministic},
                             {"frames_dropped_late", frames_dropped_late},
                             {"frames_out_of_order",
                              {{"skipped", frame_order.rejected()},
@@ -745,6 +757,10 @@ void addRunOptions(CLI::App* run, const std::shared_ptr<RunOptions>& options) {
   auto* realtime = run->add_flag("--realtime", options->realtime,
                                  "Feed frames at the dataset's rate, dropping none");
   run->add_flag("--fast", options->fast, "Feed frames as fast as possible (the default)")
+      ->excludes(realtime);
+  run->add_flag("--deterministic", options->deterministic,
+                "Local mode: map each keyframe (and close loops) before the next frame, on one "
+                "thread, so two runs give the same trajectory (for tests and bisecting; slower)")
       ->excludes(realtime);
   run->add_option("--out", options->out_dir,
                   "Output folder (trajectories, metrics.json, frames.csv with each frame's times)");

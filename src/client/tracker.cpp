@@ -436,7 +436,9 @@ void Tracker::updateLocalMap(const Frame& frame) {
   int best_count = 0;
   for (const auto& [kf, count] : counter) {
     if (kf->isBad()) continue;
-    if (count > best_count) {
+    // Ties go to the newer keyframe: the map's iteration order follows addresses, which differ
+    // from run to run.
+    if (count > best_count || (count == best_count && best != nullptr && kf->id() > best->id())) {
       best_count = count;
       best = kf;
     }
