@@ -5,11 +5,13 @@
 // no confident pose that is wrong, and metrics.json must say why.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <iostream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
@@ -148,6 +150,10 @@ TEST(DegenerateRun, HighwaySpeedForwardMotionReportsOnlyPosesItCanTrust) {
   EXPECT_GE(m["ate"]["pairs"].get<int>(), tracked);
   EXPECT_LE(m["ate"]["pairs"].get<int>(), tracked + 1);
   EXPECT_LT(m["ate"]["rmse_m"].get<double>(), 0.01 * path_m) << m["ate"].dump();
+  std::cout << "highway: tracked " << tracked << " (+" << m["tracked_in_discarded_maps"]
+            << " in a discarded map), lost " << lost << ", without a map " << without_map
+            << ", ATE (sim3) " << m["ate"]["rmse_m"].get<double>() << " m over " << path_m
+            << " m\n";
   if (lost > 0) {
     bool warned = false;
     for (const auto& warning : m["warnings"]) {
@@ -202,13 +208,20 @@ TEST(DegenerateRun, PureRotationAfterTheMapIsTrackedAsARotation) {
   }
   ASSERT_NE(before_pan, nullptr) << "the last frame before the pan was not tracked";
   std::size_t panned_tracked = 0;
+  double worst_turn_error_deg = 0.0;
   for (const StampedPose& pose : estimate) {
     if (pose.timestamp < last_walk_time + 1e-6) continue;
     ++panned_tracked;
     const double k = std::round((pose.timestamp - last_walk_time) * 30.0);
     const double turned_deg = rotationDistance(pose.pose, before_pan->pose) * 180.0 / kPi;
     EXPECT_NEAR(turned_deg, kDegreesPerFrame * k, 0.5) << "panned frame " << k;
+    worst_turn_error_deg =
+        std::max(worst_turn_error_deg, std::abs(turned_deg - kDegreesPerFrame * k));
   }
+  std::cout << "pan: " << panned_tracked << " of " << kPan
+            << " panned frames tracked, worst turn error " << worst_turn_error_deg
+            << " deg, ATE (sim3) " << m["ate"]["rmse_m"].get<double>() * 100.0 << " cm, keyframes "
+            << m["keyframes"] << ", points " << m["map_points"] << "\n";
   EXPECT_GE(panned_tracked, kPan - 2) << m.dump(2);
   // The camera centre must not wander during the pan: the whole run, walk and pan, stays within
   // the walk's accuracy (sim3: monocular scale).
