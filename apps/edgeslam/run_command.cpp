@@ -230,6 +230,8 @@ int runPipeline(const RunOptions& given) {
   slam_options.orb.validate();
   slam_options.tracker.vocabulary = loadVocabulary(options.vocabulary);
   slam_options.tracker.recover_within_frames = options.recover_frames;
+  // The mobile view draws each feature by state; without a viewer nothing is copied.
+  slam_options.tracker.report_feature_positions = options.viewer_port.has_value();
   slam_options.vocabulary = slam_options.tracker.vocabulary;
   slam_options.loop_closing = options.loop_closing;
   slam_options.client_triangulation = options.client_triangulation;
@@ -410,7 +412,7 @@ int runPipeline(const RunOptions& given) {
       const std::optional<SE3d> camera =
           result.T_cw ? std::optional<SE3d>(result.T_cw->inverse()) : std::nullopt;
       viewer->view().publishFrame(view_status, camera, frame.ground_truth);
-      viewer->publishImage(frame.color.empty() ? frame.gray : frame.color,
+      viewer->publishImage(frame.color.empty() ? frame.gray : frame.color, result,
                            slam.lastSemanticFrame());
     }
   }

@@ -39,24 +39,23 @@ std::unique_ptr<RunViewer::Attachment> RunViewer::attach(const SlamSystem& slam)
   return std::make_unique<Attachment>(&view_);
 }
 
-void RunViewer::publishImage(const cv::Mat& image, const SemanticFrame* semantic) {
+void RunViewer::publishImage(const cv::Mat& image, const TrackResult& tracked,
+                             const SemanticFrame* semantic) {
   viz::FrameImageSlot& images = *view_.images();
   if (!images.wanted() || image.empty()) return;
   viz::FrameImage frame;
   frame.image = image.clone();
-  if (semantic != nullptr && semantic->kept) {
+  frame.on_map = tracked.features_on_map;
+  frame.fresh = tracked.features_new;
+  if (semantic != nullptr && semantic->kept && semantic->all &&
+      semantic->all->size() != semantic->kept->size()) {
     std::set<std::pair<float, float>> kept;
-    for (const cv::KeyPoint& k : semantic->kept->keypoints) {
-      frame.kept.push_back(k.pt);
-      kept.emplace(k.pt.x, k.pt.y);
+    for (const cv::KeyPoint& k : semantic->kept->keypoints) kept.emplace(k.pt.x, k.pt.y);
+    for (const cv::KeyPoint& k : semantic->all->keypoints) {
+      if (!kept.contains({k.pt.x, k.pt.y})) frame.culled.push_back(k.pt);
     }
-    if (semantic->all && semantic->all->size() != semantic->kept->size()) {
-      for (const cv::KeyPoint& k : semantic->all->keypoints) {
-        if (!kept.contains({k.pt.x, k.pt.y})) frame.culled.push_back(k.pt);
-      }
-    }
-    frame.mask = semantic->mask.clone();
   }
+  if (semantic != nullptr) frame.mask = semantic->mask.clone();
   images.publish(std::move(frame));
 }
 

@@ -38,8 +38,10 @@ class RunViewer {
   [[nodiscard]] std::unique_ptr<Attachment> attach(const SlamSystem& slam);
 
   // After a frame: while a page shows the camera image (at most a few times a second), the frame
-  // with its features (kept and culled) and movable mask.
-  void publishImage(const cv::Mat& image, const SemanticFrame* semantic);
+  // with its features by state (on the map, new: from the tracking result; culled: the semantic
+  // frame's) and movable mask.
+  void publishImage(const cv::Mat& image, const TrackResult& tracked,
+                    const SemanticFrame* semantic);
 
   // Marks the run finished; with `seconds` > 0 keeps serving until then or until SIGINT.
   void finish(double linger_seconds);

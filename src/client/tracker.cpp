@@ -185,6 +185,7 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
     }
   }
 
+  if (options_.report_feature_positions) reportFeaturePositions(frame, result);
   if (ok) last_frame_ = frame;
   record(frame, ok);
   result.state = state_;
@@ -611,6 +612,16 @@ void Tracker::triangulateAtKeyFrame(KeyFrame* keyframe, Frame& frame) {
   triangulation_.ms.add(timer.elapsedMs());
   spdlog::debug("keyframe {} (frame {}): {} points triangulated on the client in {:.2f} ms",
                 keyframe->id(), frame.index, created, timer.elapsedMs());
+}
+
+void Tracker::reportFeaturePositions(const Frame& frame, TrackResult& result) const {
+  const std::vector<cv::KeyPoint>& keypoints = frame.features->keypoints;
+  result.features_on_map.reserve(keypoints.size());
+  result.features_new.reserve(keypoints.size());
+  for (std::size_t i = 0; i < keypoints.size(); ++i) {
+    const bool on_map = i < frame.points.size() && frame.points[i] != nullptr;
+    (on_map ? result.features_on_map : result.features_new).push_back(keypoints[i].pt);
+  }
 }
 
 void Tracker::record(const Frame& frame, bool tracked) {

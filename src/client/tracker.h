@@ -62,6 +62,8 @@ struct TrackerOptions {
   std::size_t triangulation_neighbours_without_bow = 1;
   float triangulation_ratio = 0.6f;  // best/second-best ratio of the pair search
   double min_triangulation_parallax_deg = kDefaultMinTriangulationParallaxDeg;
+  // Fill TrackResult::features_on_map / features_new (a viewer draws them; off, nothing is copied).
+  bool report_feature_positions = false;
 };
 
 // What triangulating at keyframes did (TrackerOptions::triangulate_at_keyframes).
@@ -134,6 +136,7 @@ class Tracker {
   void triangulateAtKeyFrame(KeyFrame* keyframe, Frame& frame);
   void record(const Frame& frame, bool tracked);
   void resetMap();
+  void reportFeaturePositions(const Frame& frame, TrackResult& result) const;
 
   Map& map_;
   const PinholeCamera& camera_;

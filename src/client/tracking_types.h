@@ -1,7 +1,9 @@
 #pragma once
 // Shared vocabulary of the tracker and whoever consumes its keyframes.
 #include <cstddef>
+#include <opencv2/core/types.hpp>
 #include <optional>
+#include <vector>
 
 #include "geometry/se3.h"
 #include "map/ids.h"
@@ -21,6 +23,11 @@ struct TrackResult {
   KeyFrameId keyframe = kInvalidId;  // the new keyframe's id
   bool relocalized = false;
   int tracked_points = 0;
+  // With TrackerOptions::report_feature_positions (for a viewer): the frame's features in pixels,
+  // those tracking matched to a map point and the rest (new: no point yet). Features culled
+  // before tracking (semantic culling) are in neither.
+  std::vector<cv::Point2f> features_on_map;
+  std::vector<cv::Point2f> features_new;
 };
 
 }  // namespace edgeslam

@@ -6,7 +6,7 @@
 
 namespace edgeslam::viz {
 
-std::string renderFrameJpeg(const FrameImage& frame, int max_width, int quality) {
+cv::Mat renderFrame(const FrameImage& frame, int max_width) {
   if (frame.image.empty()) return {};
   const double scale = std::min(1.0, static_cast<double>(max_width) / frame.image.cols);
   cv::Mat canvas;
@@ -20,13 +20,22 @@ std::string renderFrameJpeg(const FrameImage& frame, int max_width, int quality)
     cv::addWeighted(canvas, 0.55, tinted, 0.45, 0.0, canvas);
   }
   const int radius = std::max(2, static_cast<int>(3 * scale + 0.5));
-  for (const cv::Point2f& p : frame.kept) {
-    cv::circle(canvas, p * scale, radius, cv::Scalar(122, 224, 62), 1, cv::LINE_AA);
+  for (const cv::Point2f& p : frame.fresh) {
+    cv::circle(canvas, p * scale, std::max(1, radius / 2), kFreshColour, cv::FILLED, cv::LINE_AA);
+  }
+  for (const cv::Point2f& p : frame.on_map) {
+    cv::circle(canvas, p * scale, radius, kOnMapColour, 1, cv::LINE_AA);
   }
   for (const cv::Point2f& p : frame.culled) {
-    cv::drawMarker(canvas, p * scale, cv::Scalar(77, 77, 255), cv::MARKER_TILTED_CROSS,
-                   2 * radius + 1, 1, cv::LINE_AA);
+    cv::drawMarker(canvas, p * scale, kCulledColour, cv::MARKER_TILTED_CROSS, 2 * radius + 1, 1,
+                   cv::LINE_AA);
   }
+  return canvas;
+}
+
+std::string renderFrameJpeg(const FrameImage& frame, int max_width, int quality) {
+  const cv::Mat canvas = renderFrame(frame, max_width);
+  if (canvas.empty()) return {};
   std::vector<uchar> bytes;
   cv::imencode(".jpg", canvas, bytes, {cv::IMWRITE_JPEG_QUALITY, quality});
   return {bytes.begin(), bytes.end()};

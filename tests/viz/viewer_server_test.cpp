@@ -2,11 +2,13 @@
 #include "viz/viewer_server.h"
 
 // clang-format off: before httplib.h, whose macros break Eigen's headers.
+#include "viz/frame_image.h"
 #include "viz/live_view.h"
 // clang-format on
 #include <gtest/gtest.h>
 #include <httplib.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <future>
@@ -123,7 +125,8 @@ TEST_F(ViewerServerTest, CameraImageIsAJpegOnceTheRunPublishesOne) {
   ASSERT_TRUE(images.wanted());
   FrameImage frame;
   frame.image = cv::Mat(240, 320, CV_8UC1, cv::Scalar(128));
-  frame.kept = {{10, 10}, {100, 50}};
+  frame.on_map = {{10, 10}, {100, 50}};
+  frame.fresh = {{150, 60}};
   frame.culled = {{200, 100}};
   frame.mask = cv::Mat1b(240, 320, std::uint8_t{0});
   images.publish(std::move(frame));
@@ -136,14 +139,54 @@ TEST_F(ViewerServerTest, CameraImageIsAJpegOnceTheRunPublishesOne) {
   EXPECT_EQ(static_cast<unsigned char>(jpeg->body[1]), 0xD8);
 }
 
+// Each feature state is drawn in its own colour where the feature is, on a grey frame.
+TEST(FrameImage, FeaturesAreDrawnInTheColourOfTheirState) {
+  FrameImage frame;
+  frame.image = cv::Mat(240, 320, CV_8UC1, cv::Scalar(128));
+  frame.on_map = {{40, 40}};
+  frame.fresh = {{120, 40}};
+  frame.culled = {{200, 40}};
+  const cv::Mat canvas = renderFrame(frame);
+  ASSERT_EQ(canvas.type(), CV_8UC3);
+  ASSERT_EQ(canvas.size(), cv::Size(320, 240));
+  // The most saturated pixel near a point has the colour of its state.
+  const auto strongest = [&](cv::Point2f at) {
+    cv::Vec3b best(128, 128, 128);
+    int best_spread = -1;
+    for (int dy = -4; dy <= 4; ++dy) {
+      for (int dx = -4; dx <= 4; ++dx) {
+        const cv::Vec3b c =
+            canvas.at<cv::Vec3b>(static_cast<int>(at.y) + dy, static_cast<int>(at.x) + dx);
+        const int spread = std::max({c[0], c[1], c[2]}) - std::min({c[0], c[1], c[2]});
+        if (spread > best_spread) {
+          best_spread = spread;
+          best = c;
+        }
+      }
+    }
+    return best;
+  };
+  const auto dominant = [](cv::Vec3b c) {  // 0 blue, 1 green, 2 red
+    return static_cast<int>(std::max_element(&c[0], &c[0] + 3) - &c[0]);
+  };
+  EXPECT_EQ(dominant(strongest(frame.on_map[0])), 1);
+  EXPECT_EQ(dominant(strongest(frame.fresh[0])), 0);
+  EXPECT_EQ(dominant(strongest(frame.culled[0])), 2);
+  // Away from every feature the frame is untouched.
+  EXPECT_EQ(canvas.at<cv::Vec3b>(200, 160), cv::Vec3b(128, 128, 128));
+}
+
 TEST(FrameImageSlot, WantedOnlyWhileAPageAsksAndAtMostAtItsRate) {
   // One image per 2 s at most; a page counts as gone 0.5 s after its last request.
   FrameImageSlot slot(0.5, std::chrono::milliseconds(500));
   EXPECT_FALSE(slot.wanted());
   EXPECT_FALSE(slot.jpeg().has_value());
   EXPECT_TRUE(slot.wanted());
-  slot.publish(FrameImage{
-      .image = cv::Mat(8, 8, CV_8UC1, cv::Scalar(0)), .kept = {}, .culled = {}, .mask = {}});
+  slot.publish(FrameImage{.image = cv::Mat(8, 8, CV_8UC1, cv::Scalar(0)),
+                          .on_map = {},
+                          .fresh = {},
+                          .culled = {},
+                          .mask = {}});
   EXPECT_FALSE(slot.wanted());  // the next one only 2 s after this
   EXPECT_TRUE(slot.jpeg().has_value());
   std::this_thread::sleep_for(600ms);
