@@ -7,12 +7,14 @@
 #include <stdexcept>
 
 #include "commands.h"
+#include "edge/local_mapper.h"
 #include "map/map.h"
 #include "map_store_option.h"
 #include "store/map_export.h"
 #include "store/store_error.h"
 #include "store/stored_map_loader.h"
 #include "util/timing_stats.h"
+#include "vocabulary_option.h"
 
 namespace edgeslam::cli {
 namespace {
@@ -22,6 +24,7 @@ struct MapCommandOptions {
   std::string name;
   bool json = false;
   bool load = false;
+  std::string vocabulary;  // --load: as the server's --vocab
   std::string format;
   std::filesystem::path out;
 };
@@ -81,20 +84,36 @@ int mapInfo(const MapCommandOptions& o) {
   if (!info) noSuchMap(*store, o.name);
   nlohmann::json out = summaryJson(*info);
   if (o.load) {
-    // As a server resuming the map would: records read, then the maps rebuilt (covisibility too).
+    // As a server resuming the map would: records read, then the maps rebuilt (covisibility too)
+    // and, with a vocabulary, every keyframe given its bag of words (stored, else computed).
+    const std::shared_ptr<const Vocabulary> vocabulary = loadVocabulary(o.vocabulary);
     Stopwatch read_timer;
     const auto stored = store->loadMap(o.name);
     const double read_ms = read_timer.elapsedMs();
-    Stopwatch rebuild_timer;
-    std::size_t keyframes = 0, points = 0;
+    double rebuild_ms = 0.0, places_ms = 0.0;
+    std::size_t keyframes = 0, points = 0, places_stored = 0, places_computed = 0;
+    std::optional<std::uint64_t> checksum;
     for (const StoredSession& session : stored->sessions) {
       Map map;
+      Stopwatch rebuild_timer;
       loadStoredSession(session, map);
+      rebuild_ms += rebuild_timer.elapsedMs();
+      if (vocabulary != nullptr && !vocabulary->empty()) {
+        Stopwatch places_timer;
+        if (!checksum) checksum = vocabulary->checksum();
+        const int depth = LocalMapperOptions{}.direct_index_depth;
+        places_stored += attachStoredPlaces(session, map, *vocabulary, *checksum, depth).attached;
+        places_computed += describeKeyFrames(map, *vocabulary, depth);
+        places_ms += places_timer.elapsedMs();
+      }
       keyframes += map.keyFrameCount();
       points += map.pointCount();
     }
     out["load"] = {{"read_ms", read_ms},
-                   {"rebuild_ms", rebuild_timer.elapsedMs()},
+                   {"rebuild_ms", rebuild_ms},
+                   {"bow_ms", places_ms},
+                   {"bow_stored", places_stored},
+                   {"bow_computed", places_computed},
                    {"load_ms", read_timer.elapsedMs()},
                    {"keyframes", keyframes},
                    {"points", points}};
@@ -108,9 +127,13 @@ int mapInfo(const MapCommandOptions& o) {
              info->sessions, info->bytes);
   fmt::print("  created {}, updated {}\n", isoTime(info->created), isoTime(info->updated));
   if (o.load) {
-    fmt::print("  loaded in {:.1f} ms (read {:.1f} ms, rebuilt {:.1f} ms)\n",
-               out["load"]["load_ms"].get<double>(), out["load"]["read_ms"].get<double>(),
-               out["load"]["rebuild_ms"].get<double>());
+    fmt::print(
+        "  loaded in {:.1f} ms (read {:.1f} ms, rebuilt {:.1f} ms, bags of words {:.1f} ms: {} "
+        "stored, {} computed)\n",
+        out["load"]["load_ms"].get<double>(), out["load"]["read_ms"].get<double>(),
+        out["load"]["rebuild_ms"].get<double>(), out["load"]["bow_ms"].get<double>(),
+        out["load"]["bow_stored"].get<std::size_t>(),
+        out["load"]["bow_computed"].get<std::size_t>());
   }
   return 0;
 }
@@ -152,6 +175,9 @@ void addMapCommand(CLI::App& app) {
   addMapsOption(info, o->maps);
   info->add_flag("--json", o->json, "One JSON object");
   info->add_flag("--load", o->load, "Also load the map as a server would and time it");
+  info->add_option("--vocab", o->vocabulary,
+                   "With --load: the server's vocabulary, for the keyframes' bags of words "
+                   "(default: as run's --vocab; none = without)");
   info->callback([o] { exitCode() = mapInfo(*o); });
 
   auto* exp = cmd->add_subcommand("export", "Write a map as TUM keyframes, PLY points or COLMAP");
