@@ -1,4 +1,4 @@
-#!/ usr / bin / env python3
+#!/usr/bin/env python3
 """Makes a large stored map out of a real one, to time loading (docs/map_store.md, Loading).
 
 The latest session of map SOURCE in the store is copied N times into one new session of map
@@ -15,12 +15,7 @@ import struct
 import time
 
 SHIFT = 1 << 44
-
-
-def shifted(value, copy):
-    if value < 0:  # ids are unsigned 64-bit stored bit for bit; none here reach the sign bit
-        raise SystemExit("unexpected negative id")
-    return value + copy * SHIFT if value != 0xFFFFFFFFFFFFFFFF else value
+INVALID = 0xFFFFFFFFFFFFFFFF
 
 
 def signed(value):
@@ -31,12 +26,21 @@ def unsigned(value):
     return value + (1 << 64) if value < 0 else value
 
 
+def shifted(sql_value, copy):
+    value = unsigned(sql_value)
+    return signed(value if value == INVALID else value + copy * SHIFT)
+
+
 def shift_observations(blob, copy):
     out = bytearray()
     for offset in range(0, len(blob), 12):
         keyframe, index = struct.unpack_from("<QI", blob, offset)
         out += struct.pack("<QI", keyframe + copy * SHIFT, index)
     return bytes(out)
+
+
+def insert(db, table, row):
+    db.execute(f"INSERT INTO {table} VALUES({', '.join('?' * len(row))})", row)
 
 
 def main():
@@ -54,42 +58,33 @@ def main():
         (args.source,)).fetchone()
     now = time.time()
     db.execute("INSERT INTO maps(name, created, updated) VALUES(?, ?, ?)", (args.target, now, now))
-    map_id = db.execute("SELECT id FROM maps WHERE name = ?", (args.target,)).fetchone()[0]
-    columns = [r[1] for r in db.execute("PRAGMA table_info(sessions)") if r[1] not in ("id", "map_id")]
-    db.execute(f"INSERT INTO sessions(map_id, {', '.join(columns)}) SELECT ?, {', '.join(columns)} "
-               "FROM sessions WHERE id = ?", (map_id, source))
-    session = db.execute("SELECT max(id) FROM sessions").fetchone()[0]
-    keyframes = db.execute("SELECT * FROM keyframes WHERE session_id = ?", (source,)).fetchall()
-    points = db.execute("SELECT * FROM points WHERE session_id = ?", (source,)).fetchall()
-    places = db.execute("SELECT * FROM keyframe_places WHERE session_id = ?", (source,)).fetchall()
-    masks = db.execute("SELECT * FROM masks WHERE session_id = ?", (source,)).fetchall()
+    (map_id,) = db.execute("SELECT id FROM maps WHERE name = ?", (args.target,)).fetchone()
+    columns = [r[1] for r in db.execute("PRAGMA table_info(sessions)")
+               if r[1] not in ("id", "map_id")]
+    db.execute(f"INSERT INTO sessions(map_id, {', '.join(columns)}) SELECT ?, "
+               f"{', '.join(columns)} FROM sessions WHERE id = ?", (map_id, source))
+    (session,) = db.execute("SELECT max(id) FROM sessions").fetchone()
+    rows = {table: db.execute(f"SELECT * FROM {table} WHERE session_id = ?", (source,)).fetchall()
+            for table in ("keyframes", "points", "keyframe_places", "masks")}
     for copy in range(args.copies):
-        for k in keyframes:
+        for k in rows["keyframes"]:  # session_id, id, frame_index, timestamp, pose, parent, ...
             row = list(k)
-            row[0] = session
-            row[1] = signed(shifted(unsigned(k[1]), copy))
-            row[5] = signed(shifted(unsigned(k[5]), copy))  # parent
-            db.execute(f"INSERT INTO keyframes VALUES({', '.join('?' * len(row))})", row)
-        for p in points:
+            row[0], row[1], row[5] = session, shifted(k[1], copy), shifted(k[5], copy)
+            insert(db, "keyframes", row)
+        for p in rows["points"]:  # session_id, id, x..nz, descriptor, min, max, reference, obs
             row = list(p)
-            row[0] = session
-            row[1] = signed(shifted(unsigned(p[1]), copy))
-            row[11] = signed(shifted(unsigned(p[11]), copy))  # reference keyframe
+            row[0], row[1], row[11] = session, shifted(p[1], copy), shifted(p[11], copy)
             row[12] = shift_observations(p[12], copy)
-            db.execute(f"INSERT INTO points VALUES({', '.join('?' * len(row))})", row)
-        for p in places:
-            row = list(p)
-            row[0] = session
-            row[1] = signed(shifted(unsigned(p[1]), copy))
-            db.execute(f"INSERT INTO keyframe_places VALUES({', '.join('?' * len(row))})", row)
-        for m in masks:
-            row = list(m)
-            row[0] = session
-            row[1] = signed(shifted(unsigned(m[1]), copy))
-            db.execute(f"INSERT INTO masks VALUES({', '.join('?' * len(row))})", row)
+            insert(db, "points", row)
+        for table in ("keyframe_places", "masks"):  # session_id, keyframe, ...
+            for r in rows[table]:
+                row = list(r)
+                row[0], row[1] = session, shifted(r[1], copy)
+                insert(db, table, row)
     db.commit()
-    print(f"map '{args.target}': {len(keyframes) * args.copies} keyframes, "
-          f"{len(points) * args.copies} points, {len(places) * args.copies} places "
+    print(f"map '{args.target}': {len(rows['keyframes']) * args.copies} keyframes, "
+          f"{len(rows['points']) * args.copies} points, "
+          f"{len(rows['keyframe_places']) * args.copies} places "
           f"({args.copies} copies of '{args.source}' session {source})")
 
 
