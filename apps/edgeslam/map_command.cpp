@@ -25,7 +25,7 @@ struct MapCommandOptions {
   std::string name;
   bool json = false;
   bool load = false;
-  std::string vocabulary;  // --load: as the server's --vocab
+  std::string vocabulary = "none";  // --load: the server's --vocab, for the bags of words
   std::string format;
   std::filesystem::path out;
 };
@@ -95,7 +95,14 @@ int mapInfo(const MapCommandOptions& o) {
   if (o.load) {
     // As a server resuming the map would: records read, then the maps rebuilt (covisibility too)
     // and, with a vocabulary, every keyframe given its bag of words (stored, else computed).
-    const std::shared_ptr<const Vocabulary> vocabulary = loadVocabulary(o.vocabulary);
+    std::shared_ptr<const Vocabulary> vocabulary;
+    {
+      // Logs go to stdout: with --json only the object may be there.
+      const spdlog::level::level_enum level = spdlog::get_level();
+      if (o.json) spdlog::set_level(spdlog::level::err);
+      vocabulary = loadVocabulary(o.vocabulary);
+      spdlog::set_level(level);
+    }
     const double cpu_start_ms = processCpuMs();
     Stopwatch read_timer;
     const auto stored = store->loadMap(o.name);
@@ -190,8 +197,9 @@ void addMapCommand(CLI::App& app) {
   info->add_flag("--json", o->json, "One JSON object");
   info->add_flag("--load", o->load, "Also load the map as a server would and time it");
   info->add_option("--vocab", o->vocabulary,
-                   "With --load: the server's vocabulary, for the keyframes' bags of words "
-                   "(default: as run's --vocab; none = without)");
+                   "With --load: the server's vocabulary, for the keyframes' bags of words (stored "
+                   "ones are used, the others computed); default none, \"\" = as run's default")
+      ->capture_default_str();
   info->callback([o] { exitCode() = mapInfo(*o); });
 
   auto* exp = cmd->add_subcommand("export", "Write a map as TUM keyframes, PLY points or COLMAP");
