@@ -1,7 +1,7 @@
 // Bounded growth as a user meets it: `run --repeat 3` plays the same 300 frames of redkitchen three
 // times into one edge map. At each pass boundary the camera jumps back to the first frame: the
-// client must relocalise into the map it has (no new map, same frame), and the edge must not grow
-// the map by the revisits' redundant keyframes.
+// client must go on in the map it has (relocalised, or tracked across; no new map, same frame),
+// and the edge must not grow the map by the revisits' redundant keyframes.
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -18,7 +18,7 @@ namespace {
 
 constexpr const char* kSequence = "datasets/7scenes-redkitchen-1000";
 
-TEST(MapRepeat, ThreePassesRelocaliseIntoOneMapThatStaysBounded) {
+TEST(MapRepeat, ThreePassesGoOnInOneMapThatStaysBounded) {
   EDGESLAM_REQUIRE_SHARED(kSequence);
   const auto store = test::freshTempDir("map_repeat_store");
   const auto out = test::freshTempDir("map_repeat_out");
@@ -50,8 +50,9 @@ TEST(MapRepeat, ThreePassesRelocaliseIntoOneMapThatStaysBounded) {
     EXPECT_LT(pass["ate_in_run_alignment_rmse_m"].get<double>(),
               pass["ate"]["rmse_m"].get<double>() + 0.02);
     if (k > 0) {
-      // The camera jumped from frame 299 back to frame 0: lost, then found again in the map.
-      EXPECT_GE(pass["relocalized"].get<int>(), 1);
+      // The camera jumped from frame 299 back to frame 0: lost and found again in the map (most
+      // runs), or tracked straight across in it; in either case in the first pass's frame (above).
+      EXPECT_TRUE(pass["relocalized"].get<int>() >= 1 || pass["lost"].get<int>() == 0);
       // Growth bound of issue 19 (5 passes <= 1.5x after the first), here after 3.
       EXPECT_LE(pass["map_keyframes"].get<double>(), 1.5 * first_keyframes);
     }
