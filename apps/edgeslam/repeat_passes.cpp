@@ -52,13 +52,15 @@ void PassLog::addFrame(std::size_t index, double timestamp, const TrackResult& r
 }
 
 void PassLog::afterFrame(std::size_t index, bool last_of_run, const SlamSystem& slam,
+                         const std::function<std::optional<EdgeMapSize>()>& edge_map,
                          double wall_s) {
   if (!open_) return;  // every frame of the pass so far was skipped
   if (!last_of_run && (frames_per_pass_ == 0 || (index + 1) % frames_per_pass_ != 0)) return;
   PassRecord& pass = passes_.back();
   pass.last_frame = index;
-  pass.map_keyframes = slam.keyFrameCount();
-  pass.map_points = slam.mapPointCount();
+  const std::optional<EdgeMapSize> edge = edge_map ? edge_map() : std::nullopt;
+  pass.map_keyframes = edge ? edge->keyframes : slam.keyFrameCount();
+  pass.map_points = edge ? edge->points : slam.mapPointCount();
   pass.map_resets = slam.mapResets();
   pass.rss_bytes = residentBytes();
   pass.peak_rss_bytes = peakResidentBytes();

@@ -3,7 +3,9 @@
 // its end (metrics.json "passes"), to show that a map revisiting the same place stays bounded.
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <vector>
 
 #include "client/tracking_types.h"
@@ -15,6 +17,12 @@ class SlamSystem;
 }
 
 namespace edgeslam::cli {
+
+// The edge session's map where the client does not report it (offload).
+struct EdgeMapSize {
+  std::size_t keyframes = 0;
+  std::size_t points = 0;
+};
 
 struct PassRecord {
   std::size_t first_frame = 0;  // run-wide frame indices, inclusive
@@ -39,8 +47,11 @@ class PassLog {
   explicit PassLog(std::size_t frames_per_pass) : frames_per_pass_(frames_per_pass) {}
 
   void addFrame(std::size_t index, double timestamp, const TrackResult& result);
-  // Call after each frame: closes the pass when `index` is its last frame (or the run's).
-  void afterFrame(std::size_t index, bool last_of_run, const SlamSystem& slam, double wall_s);
+  // Call after each frame: closes the pass when `index` is its last frame (or the run's). The map's
+  // size is what `edge_map` says when it says something (asked at pass ends only), else the
+  // SlamSystem's.
+  void afterFrame(std::size_t index, bool last_of_run, const SlamSystem& slam,
+                  const std::function<std::optional<EdgeMapSize>()>& edge_map, double wall_s);
 
   const std::vector<PassRecord>& passes() const { return passes_; }
   // One entry per pass, with its ATE (own alignment, and within the whole run's alignment, which

@@ -39,6 +39,7 @@
 #include "store/store_location.h"
 #include "tracking_diagnostics_json.h"
 #include "util/timing_stats.h"
+#include "viz/viewed_session_factory.h"
 #include "vocabulary_option.h"
 
 namespace edgeslam::cli {
@@ -97,8 +98,22 @@ Sensor toSensor(const std::string& name) {
 // process on loopback, behind the link emulator when a profile is asked for.
 struct EdgeEndpoint {
   MapStoreChoice store;  // the embedded edge's; declared first, so the edge goes before it
+  // The embedded edge's sessions, where the client does not hold the map (offload): their maps'
+  // size per pass of --repeat.
+  std::shared_ptr<viz::SessionDirectory> sessions;
   std::unique_ptr<EmbeddedEdge> embedded;
   std::string address;
+
+  std::optional<EdgeMapSize> sessionMapSize() const {
+    if (!sessions) return std::nullopt;
+    for (const viz::SessionDirectory::Entry& entry : sessions->sessions()) {
+      if (const auto backend = entry.backend.lock()) {
+        const MapSample sample = backend->mapSample(0);
+        return EdgeMapSize{sample.keyframe_poses.size(), sample.total_points};
+      }
+    }
+    return std::nullopt;
+  }
 };
 
 EdgeEndpoint openEdge(const RunOptions& options, std::shared_ptr<const Vocabulary> vocabulary) {
@@ -130,7 +145,14 @@ EdgeEndpoint openEdge(const RunOptions& options, std::shared_ptr<const Vocabular
   if (options.mode == "edge") edge.store = openStoreForWriting(options.maps);
   session.store = edge.store.store;
   session.store_stats = edge.store.stats;
-  edge.embedded = std::make_unique<EmbeddedEdge>(session, link);
+  EmbeddedEdge::FactoryWrapper wrap;
+  if (options.mode == "offload" && options.repeat > 1) {
+    edge.sessions = std::make_shared<viz::SessionDirectory>();
+    wrap = [directory = edge.sessions](std::shared_ptr<EdgeSessionFactory> inner) {
+      return std::make_shared<viz::ViewedSessionFactory>(std::move(inner), directory);
+    };
+  }
+  edge.embedded = std::make_unique<EmbeddedEdge>(session, link, wrap);
   edge.address = edge.embedded->clientAddress();
   spdlog::info("edge server on loopback, client connects to {}{}", edge.address,
                link ? " through link " + link->describe() : std::string());
@@ -314,10 +336,13 @@ int runPipeline(const RunOptions& given) {
         *reader, frame_count,
         FramePrefetcherOptions{.frames_ahead = 4, .thread_nice = slam_options.background_nice});
   }
+  const auto edge_map_size = [&edge] { return edge.sessionMapSize(); };
   std::optional<PassLog> pass_log;
   if (options.repeat > 1) pass_log.emplace(frames_per_pass);
   for (std::size_t i = 0; i < frame_count; ++i) {
-    if (pass_log && i > 0) pass_log->afterFrame(i - 1, false, slam, wall.elapsedMs() / 1000.0);
+    if (pass_log && i > 0) {
+      pass_log->afterFrame(i - 1, false, slam, edge_map_size, wall.elapsedMs() / 1000.0);
+    }
     Stopwatch load_timer;
     const PrefetchedFrame prefetched =
         prefetcher ? prefetcher->next() : PrefetchedFrame{reader->load(i), 0.0};
@@ -407,7 +432,7 @@ int runPipeline(const RunOptions& given) {
   }
   progress.finish();
   if (pass_log && frame_count > 0) {
-    pass_log->afterFrame(frame_count - 1, true, slam, wall.elapsedMs() / 1000.0);
+    pass_log->afterFrame(frame_count - 1, true, slam, edge_map_size, wall.elapsedMs() / 1000.0);
   }
   slam.finish();
   // What the edge's map store holds now (the last changes written first).
