@@ -1,6 +1,7 @@
 #include "repeat_passes.h"
 
 #include <fmt/format.h>
+#include <malloc.h>
 
 #include <algorithm>
 #include <cmath>
@@ -64,6 +65,8 @@ void PassLog::afterFrame(std::size_t index, bool last_of_run, const SlamSystem& 
   pass.map_resets = slam.mapResets();
   pass.rss_bytes = residentBytes();
   pass.peak_rss_bytes = peakResidentBytes();
+  const struct mallinfo2 heap = mallinfo2();
+  pass.heap_in_use_bytes = heap.uordblks + heap.hblkhd;
   pass.wall_s = wall_s;
   open_ = false;
 }
@@ -91,6 +94,7 @@ nlohmann::json PassLog::json(const Trajectory& ground_truth, const Trajectory& e
                            {"map_resets", p.map_resets},
                            {"rss_bytes", p.rss_bytes},
                            {"peak_rss_bytes", p.peak_rss_bytes},
+                           {"heap_in_use_bytes", p.heap_in_use_bytes},
                            {"wall_s", p.wall_s}};
     const Trajectory gt = within(ground_truth, p.first_timestamp, p.last_timestamp);
     const Trajectory est = within(estimate, p.first_timestamp, p.last_timestamp);

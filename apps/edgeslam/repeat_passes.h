@@ -39,6 +39,7 @@ struct PassRecord {
   std::size_t map_resets = 0;  // in the run so far
   std::uint64_t rss_bytes = 0;
   std::uint64_t peak_rss_bytes = 0;
+  std::uint64_t heap_in_use_bytes = 0;  // malloc's allocated bytes (live objects, not free chunks)
   double wall_s = 0.0;
 };
 
