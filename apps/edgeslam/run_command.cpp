@@ -19,6 +19,7 @@
 #include "io/frame_order_guard.h"
 #include "io/frame_prefetcher.h"
 #include "io/frame_range.h"
+#include "io/repeated_dataset.h"
 #include "io/trajectory.h"
 #include "link/link_settings.h"
 #include "map_store_option.h"
@@ -30,6 +31,7 @@
 #include "pipeline/run_warnings.h"
 #include "place/vocabulary.h"
 #include "progress_line.h"
+#include "repeat_passes.h"
 #include "run_options.h"
 #include "run_viewer.h"
 #include "segmenter_option.h"
@@ -37,6 +39,7 @@
 #include "store/store_location.h"
 #include "tracking_diagnostics_json.h"
 #include "util/timing_stats.h"
+#include "viz/viewed_session_factory.h"
 #include "vocabulary_option.h"
 
 namespace edgeslam::cli {
@@ -95,8 +98,22 @@ Sensor toSensor(const std::string& name) {
 // process on loopback, behind the link emulator when a profile is asked for.
 struct EdgeEndpoint {
   MapStoreChoice store;  // the embedded edge's; declared first, so the edge goes before it
+  // The embedded edge's sessions, where the client does not hold the map (offload): their maps'
+  // size per pass of --repeat.
+  std::shared_ptr<viz::SessionDirectory> sessions;
   std::unique_ptr<EmbeddedEdge> embedded;
   std::string address;
+
+  std::optional<EdgeMapSize> sessionMapSize() const {
+    if (!sessions) return std::nullopt;
+    for (const viz::SessionDirectory::Entry& entry : sessions->sessions()) {
+      if (const auto backend = entry.backend.lock()) {
+        const MapSample sample = backend->mapSample(0);
+        return EdgeMapSize{sample.keyframe_poses.size(), sample.total_points};
+      }
+    }
+    return std::nullopt;
+  }
 };
 
 EdgeEndpoint openEdge(const RunOptions& options, std::shared_ptr<const Vocabulary> vocabulary) {
@@ -128,7 +145,14 @@ EdgeEndpoint openEdge(const RunOptions& options, std::shared_ptr<const Vocabular
   if (options.mode == "edge") edge.store = openStoreForWriting(options.maps);
   session.store = edge.store.store;
   session.store_stats = edge.store.stats;
-  edge.embedded = std::make_unique<EmbeddedEdge>(session, link);
+  EmbeddedEdge::FactoryWrapper wrap;
+  if (options.mode == "offload" && options.repeat > 1) {
+    edge.sessions = std::make_shared<viz::SessionDirectory>();
+    wrap = [directory = edge.sessions](std::shared_ptr<EdgeSessionFactory> inner) {
+      return std::make_shared<viz::ViewedSessionFactory>(std::move(inner), directory);
+    };
+  }
+  edge.embedded = std::make_unique<EmbeddedEdge>(session, link, wrap);
   edge.address = edge.embedded->clientAddress();
   spdlog::info("edge server on loopback, client connects to {}{}", edge.address,
                link ? " through link " + link->describe() : std::string());
@@ -199,6 +223,8 @@ int runPipeline(const RunOptions& given) {
       throw CLI::ValidationError("--frames", e.what());  // a usage error, known once the data is
     }
   }
+  const std::size_t frames_per_pass = reader->info().frame_count;
+  if (options.repeat > 1) reader = repeatFrames(std::move(reader), options.repeat);
   const DatasetInfo& info = reader->info();
   const std::string sensor_name = resolveSensor(options.sensor, info);
   if (sensor_name == "stereo") {
@@ -324,7 +350,13 @@ int runPipeline(const RunOptions& given) {
         *reader, frame_count,
         FramePrefetcherOptions{.frames_ahead = 4, .thread_nice = slam_options.background_nice});
   }
+  const auto edge_map_size = [&edge] { return edge.sessionMapSize(); };
+  std::optional<PassLog> pass_log;
+  if (options.repeat > 1) pass_log.emplace(frames_per_pass);
   for (std::size_t i = 0; i < frame_count; ++i) {
+    if (pass_log && i > 0) {
+      pass_log->afterFrame(i - 1, false, slam, edge_map_size, wall.elapsedMs() / 1000.0);
+    }
     Stopwatch load_timer;
     const PrefetchedFrame prefetched =
         prefetcher ? prefetcher->next() : PrefetchedFrame{reader->load(i), 0.0};
@@ -354,7 +386,9 @@ int runPipeline(const RunOptions& given) {
     const TrackResult result =
         slam.process(i, frame.timestamp, frame.gray, frame.depth, frame.color);
     const double processing_ms = frame_timer.elapsedMs();
-    if (semantic_eval) semantic_eval->addFrame(i, result, slam.lastSemanticFrame());
+    if (semantic_eval)
+      semantic_eval->addFrame(i % frames_per_pass, result, slam.lastSemanticFrame());
+    if (pass_log) pass_log->addFrame(i, frame.timestamp, result);
     client_ms.add(processing_ms);
     double frame_e2e_ms = processing_ms;
     if (options.realtime) {
@@ -417,6 +451,9 @@ int runPipeline(const RunOptions& given) {
     }
   }
   progress.finish();
+  if (pass_log && frame_count > 0) {
+    pass_log->afterFrame(frame_count - 1, true, slam, edge_map_size, wall.elapsedMs() / 1000.0);
+  }
   slam.finish();
   // What the edge's map store holds now (the last changes written first).
   const nlohmann::json store_metrics = storeMetrics(edge.store, options.map_name);
@@ -574,6 +611,10 @@ int runPipeline(const RunOptions& given) {
     metrics["semantic"] = semantic;
   }
   if (ate) metrics["ate"] = *ate;
+  if (pass_log) {
+    metrics["repeat"] = options.repeat;
+    metrics["passes"] = pass_log->json(ground_truth, at_time, align);
+  }
   if (ate_final) metrics["ate_final"] = *ate_final;
   if (!store_metrics.is_null()) metrics["store"] = store_metrics;
   if (viewer) metrics["viewer_port"] = viewer->port();
@@ -635,6 +676,7 @@ int runPipeline(const RunOptions& given) {
     fmt::print("  ATE ({})    rmse {:.4f} m  ({} poses, at frame time)\n", toString(align),
                (*ate)["rmse_m"].get<double>(), (*ate)["pairs"].get<std::size_t>());
   }
+  if (pass_log) pass_log->print();
   if (ate_final) {
     fmt::print("  ATE final    rmse {:.4f} m  ({} poses, refined)\n",
                (*ate_final)["rmse_m"].get<double>(), (*ate_final)["pairs"].get<std::size_t>());
@@ -729,7 +771,14 @@ void addRunOptions(CLI::App* run, const std::shared_ptr<RunOptions>& options) {
                   "velocity and is searched for there before relocalisation (0 = off)")
       ->check(CLI::Range(0, 300))
       ->capture_default_str();
-  run->add_option("--max-frames", options->max_frames, "Process at most N frames (0 = all)");
+  auto* max_frames =
+      run->add_option("--max-frames", options->max_frames, "Process at most N frames (0 = all)");
+  run->add_option("--repeat", options->repeat,
+                  "Play the frames N times in a row into one map (the camera jumps back to the "
+                  "first frame at each pass); metrics.json \"passes\" has each pass's figures")
+      ->check(CLI::Range(1, 1000))
+      ->excludes(max_frames)
+      ->capture_default_str();
   run->add_option_function<std::string>(
          "--frames",
          [options](const std::string& text) { options->frames = parseFrameRange(text); },

@@ -33,6 +33,7 @@ struct RunOptions {
   std::size_t recover_frames = TrackerOptions{}.recover_within_frames;
   std::size_t max_frames = 0;        // 0 = all
   std::optional<FrameRange> frames;  // `--frames A-B`: only these frames of the dataset
+  std::size_t repeat = 1;            // `--repeat N`: the frames played N times into one map
   bool realtime = false;             // feed at the dataset's rate (default: as fast as possible)
   bool fast = false;                 // explicit request for the default
   bool deterministic = false;        // local: lock-step back end, one thread, identical runs

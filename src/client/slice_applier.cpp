@@ -1,5 +1,6 @@
 #include "client/slice_applier.h"
 
+#include <algorithm>
 #include <optional>
 #include <unordered_set>
 #include <utility>
@@ -48,6 +49,11 @@ SliceApplyResult applySlice(Map& map, const MapSlice& slice, const PinholeCamera
   SliceApplyResult result;
   std::lock_guard lock(map.updateMutex());
   map.setChangeRecording(false);
+  // Before the slice's erasures: a keyframe the edge culled as soon as it had mapped it (a
+  // revisit) still tells how far mapping has come.
+  if (const KeyFrame* processed = map.keyFrame(slice.processed_keyframe)) {
+    result.frame_index = processed->frameIndex();
+  }
   KeyFrameSet touched;
   // Evictions first: the keyframes and points coming back below must not be dropped again.
   for (KeyFrameId id : slice.keyframes_evicted) {
@@ -142,7 +148,7 @@ SliceApplyResult applySlice(Map& map, const MapSlice& slice, const PinholeCamera
     }
   }
   if (const KeyFrame* processed = map.keyFrame(slice.processed_keyframe)) {
-    result.frame_index = processed->frameIndex();
+    result.frame_index = std::max(result.frame_index, processed->frameIndex());
   }
   result.keyframes_held = map.heldKeyFrameCount();
   result.points_held = map.pointCount();

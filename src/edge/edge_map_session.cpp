@@ -220,7 +220,11 @@ void EdgeMapSession::publishSlice(KeyFrame* mapped, std::uint64_t answers) {
       if (!masks.empty()) observer_->onMasks(masks);
     }
     slice = buildSlice(map_, changes);
-    if (mapped != nullptr && !mapped->isBad()) window_centre_ = mapped->id();
+    // A keyframe culled as soon as it was mapped (a revisit) hands the window to the keyframe it
+    // hangs from in the spanning tree, near where the camera is.
+    KeyFrame* centre = mapped;
+    while (centre != nullptr && centre->isBad()) centre = centre->parent();
+    if (centre != nullptr) window_centre_ = centre->id();
     // Loop corrections and global BA keep the window of the last mapped keyframe.
     const std::size_t entering_before = slice.keyframes.size();
     window_.shape(map_, map_.keyFrame(window_centre_), slice);

@@ -212,6 +212,7 @@ void LocalMapper::mapKeyFrame(KeyFrame* keyframe) {
     }
     if (options_.cull_keyframes) cullKeyFrames(keyframe);
   }
+  if (options_.cull_keyframes && options_.cull_revisits) cullRevisit(keyframe);
   last_optimized_frame_ = keyframe->frameIndex();
 }
 
@@ -351,39 +352,83 @@ void LocalMapper::fuseWithNeighbours(KeyFrame* keyframe) {
   map_.updateConnections(keyframe);
 }
 
+KeyFrameRedundancy LocalMapper::redundancy(const KeyFrame& kf) const {
+  const FrameFeatures& f = kf.features();
+  const float close_depth = 40.f * f.bf / static_cast<float>(camera_.fx());
+  KeyFrameRedundancy r;
+  for (std::size_t i = 0; i < kf.size(); ++i) {
+    MapPoint* p = kf.point(i);
+    if (p == nullptr || p->isBad()) continue;
+    // With depth, only close points (those measured well by it) count.
+    if (!options_.monocular && (!f.hasDepth(i) || f.depth[i] > close_depth)) continue;
+    ++r.points;
+    if (p->observations().size() <= 3) continue;
+    const int level = f.keypoints[i].octave;
+    int seen_by = 0;
+    for (const auto& [id, obs] : p->observations()) {
+      if (obs.keyframe == &kf) continue;
+      if (obs.keyframe->features().keypoints[obs.index].octave <= level + 1 && ++seen_by >= 3) {
+        break;
+      }
+    }
+    if (seen_by >= 3) ++r.redundant;
+  }
+  return r;
+}
+
+bool LocalMapper::cullRevisit(KeyFrame* keyframe) {
+  std::lock_guard lock(map_.updateMutex());
+  if (keyframe->isBad() || keyframe == map_.originKeyFrame() || keyframe->isProtected()) {
+    return false;
+  }
+  const double depth = keyframe->medianSceneDepth();
+  if (!(depth > 0.0)) return false;
+  const double max_distance = options_.revisit_distance_ratio * depth;
+  const double min_cos = std::cos(options_.revisit_max_angle_deg * M_PI / 180.0);
+  const Eigen::Vector3d axis = keyframe->poseInverse().rotation() * Eigen::Vector3d::UnitZ();
+  for (KeyFrame* older :
+       keyframe->covisiblesWithWeightAtLeast(options_.revisit_min_shared_points)) {
+    if (older->isBad() ||
+        older->frameIndex() + options_.revisit_min_frames > keyframe->frameIndex()) {
+      continue;
+    }
+    if ((older->cameraCenter() - keyframe->cameraCenter()).norm() > max_distance) continue;
+    const Eigen::Vector3d older_axis = older->poseInverse().rotation() * Eigen::Vector3d::UnitZ();
+    if (older_axis.dot(axis) < min_cos) continue;
+    spdlog::debug(
+        "keyframe of frame {} culled on a revisit: frame {}'s keyframe saw the same ({} "
+        "points shared, {:.3f} apart)",
+        keyframe->frameIndex(), older->frameIndex(), keyframe->weight(older),
+        (older->cameraCenter() - keyframe->cameraCenter()).norm());
+    map_.eraseKeyFrame(keyframe);
+    std::lock_guard stats_lock(stats_mutex_);
+    ++stats_.keyframes_culled;
+    ++stats_.revisit_keyframes_culled;
+    return true;
+  }
+  return false;
+}
+
 void LocalMapper::cullKeyFrames(KeyFrame* keyframe) {
   // A keyframe is redundant when 90 % of its points are seen, at the same or a finer scale, by at
   // least three other keyframes.
   std::lock_guard lock(map_.updateMutex());
   if (keyframe->isBad()) return;
   std::size_t culled = 0;
+  double best = 0.0;
+  std::size_t checked = 0;
   for (KeyFrame* kf : keyframe->bestCovisibles(static_cast<std::size_t>(-1))) {
     if (kf->isBad() || kf == map_.originKeyFrame() || kf->isProtected()) continue;
-    const FrameFeatures& f = kf->features();
-    const float close_depth = 40.f * f.bf / static_cast<float>(camera_.fx());
-    int points = 0, redundant = 0;
-    for (std::size_t i = 0; i < kf->size(); ++i) {
-      MapPoint* p = kf->point(i);
-      if (p == nullptr || p->isBad()) continue;
-      // With depth, only close points (those measured well by it) count.
-      if (!options_.monocular && (!f.hasDepth(i) || f.depth[i] > close_depth)) continue;
-      ++points;
-      if (p->observations().size() <= 3) continue;
-      const int level = f.keypoints[i].octave;
-      int seen_by = 0;
-      for (const auto& [id, obs] : p->observations()) {
-        if (obs.keyframe == kf) continue;
-        if (obs.keyframe->features().keypoints[obs.index].octave <= level + 1 && ++seen_by >= 3) {
-          break;
-        }
-      }
-      if (seen_by >= 3) ++redundant;
-    }
-    if (points > 0 && redundant > options_.redundant_ratio * points) {
+    const KeyFrameRedundancy r = redundancy(*kf);
+    ++checked;
+    if (r.points > 0) best = std::max(best, static_cast<double>(r.redundant) / r.points);
+    if (r.points > 0 && r.redundant > options_.redundant_ratio * r.points) {
       map_.eraseKeyFrame(kf);
       ++culled;
     }
   }
+  spdlog::debug("keyframe culling at frame {}: {} covisibles checked, best ratio {:.2f}, {} culled",
+                keyframe->frameIndex(), checked, best, culled);
   std::lock_guard stats_lock(stats_mutex_);
   stats_.keyframes_culled += culled;
 }

@@ -59,6 +59,17 @@ struct LocalMapperOptions {
   // culling those as unobserved.
   bool observe_recent_points = false;
   bool cull_keyframes = true;
+  // Revisits: a new keyframe that sees what an older keyframe (made at least
+  // `revisit_min_frames` frames before) saw from about the same viewpoint (camera centres closer
+  // than `revisit_distance_ratio` x the new keyframe's median scene depth, optical axes within
+  // `revisit_max_angle_deg`, at least `revisit_min_shared_points` points in common) is culled:
+  // a camera going over mapped ground again does not grow the map. The redundancy rule above
+  // rarely fires there, as each RGB-D keyframe brings hundreds of fresh depth points.
+  bool cull_revisits = true;
+  std::size_t revisit_min_frames = 150;
+  double revisit_distance_ratio = 0.1;
+  double revisit_max_angle_deg = 15.0;
+  int revisit_min_shared_points = 30;
   // Nice increment for the mapping thread (util/thread_priority.h); 0 leaves it as it is.
   int thread_nice = 0;
 };
@@ -68,6 +79,7 @@ struct LocalMapperStats {
   std::size_t points_created = 0;
   std::size_t points_culled = 0;
   std::size_t keyframes_culled = 0;
+  std::size_t revisit_keyframes_culled = 0;  // of keyframes_culled, new keyframes on revisits
   std::size_t local_ba_runs = 0;
   // Triangulation searches (and how many went through bag of words), the pairs they proposed and
   // their total wall time.
@@ -75,6 +87,13 @@ struct LocalMapperStats {
   std::size_t triangulation_bow_searches = 0;
   std::size_t triangulation_pairs = 0;
   double triangulation_search_ms = 0.0;
+};
+
+// Of a keyframe's points (with depth: its close points), those seen at the same or a finer scale
+// by at least three other keyframes.
+struct KeyFrameRedundancy {
+  std::size_t points = 0;
+  std::size_t redundant = 0;
 };
 
 class LocalMapper : public KeyFrameSink {
@@ -121,6 +140,9 @@ class LocalMapper : public KeyFrameSink {
   void createNewPoints(KeyFrame* keyframe);
   void fuseWithNeighbours(KeyFrame* keyframe);
   void cullKeyFrames(KeyFrame* keyframe);
+  KeyFrameRedundancy redundancy(const KeyFrame& keyframe) const;  // under the map's mutex
+  // Culls `keyframe` itself when an older keyframe covers its view (cull_revisits).
+  bool cullRevisit(KeyFrame* keyframe);
   bool hasPending() const;
 
   Map& map_;

@@ -2,9 +2,11 @@
 
 namespace edgeslam {
 
-EmbeddedEdge::EmbeddedEdge(SlamSessionOptions options, std::optional<LinkSettings> link) {
-  server_ =
-      std::make_unique<EdgeServer>("127.0.0.1:0", std::make_shared<SlamSessionFactory>(options));
+EmbeddedEdge::EmbeddedEdge(SlamSessionOptions options, std::optional<LinkSettings> link,
+                           const FactoryWrapper& wrap) {
+  std::shared_ptr<EdgeSessionFactory> factory = std::make_shared<SlamSessionFactory>(options);
+  if (wrap) factory = wrap(std::move(factory));
+  server_ = std::make_unique<EdgeServer>("127.0.0.1:0", std::move(factory));
   if (link) {
     LinkEmulatorOptions emulator;
     emulator.listen = {"127.0.0.1", 0};

@@ -120,10 +120,21 @@ void SlamSessionBackend::makeMapping(std::optional<StoredSession> resumed) {
       static_cast<std::size_t>(std::max(0, config_.settings.client_map_keyframes));
   double rebuild_ms = 0.0;
   std::vector<KeyFrameId> stored_keyframes;
+  std::vector<KeyFrameId> places_missing;
+  std::size_t places_attached = 0;
   if (resumed) {
     mapping.preload = [&](Map& map) {
       Stopwatch timer;
       loadStoredSession(*resumed, map);
+      // Bags of words stored with the keyframes spare computing them again (~1.8 ms each).
+      const std::shared_ptr<const Vocabulary>& vocabulary =
+          mapping.mapper.vocabulary ? mapping.mapper.vocabulary : mapping.vocabulary;
+      if (vocabulary != nullptr && !vocabulary->empty()) {
+        AttachedPlaces places = attachStoredPlaces(
+            *resumed, map, *vocabulary, vocabulary->checksum(), mapping.mapper.direct_index_depth);
+        places_attached = places.attached;
+        places_missing = std::move(places.missing);
+      }
       // Edge ids made after the last batch the store kept may still name elements a client
       // holds: new ones start well beyond.
       std::uint64_t newest_edge_id = 0;
@@ -147,13 +158,13 @@ void SlamSessionBackend::makeMapping(std::optional<StoredSession> resumed) {
     const std::size_t keyframes = std::max<std::size_t>(1, loaded.keyframes_loaded);
     spdlog::info(
         "session {}: map '{}' resumed: {} keyframes, {} points; rebuilt in {:.0f} ms, bags of "
-        "words {:.0f} ms ({:.1f} ms per keyframe)",
+        "words {:.0f} ms ({} stored, {} computed; {:.1f} ms per keyframe)",
         config_.session_id, config_.map_name, loaded.keyframes_loaded, resumed->points.size(),
-        rebuild_ms, loaded.load_describe_ms,
+        rebuild_ms, loaded.load_describe_ms, places_attached, places_missing.size(),
         (rebuild_ms + loaded.load_describe_ms) / static_cast<double>(keyframes));
   }
   startStoreWriter(resumed ? std::optional<StoreSessionId>(resumed->id) : std::nullopt,
-                   stored_keyframes);
+                   stored_keyframes, places_missing);
 }
 
 void SlamSessionBackend::onKeyFrame(KeyFrameUpload upload) {
@@ -169,7 +180,8 @@ void SlamSessionBackend::onFullResyncRequested() {
 }
 
 void SlamSessionBackend::startStoreWriter(std::optional<StoreSessionId> resumed,
-                                          const std::vector<KeyFrameId>& stored_keyframes) {
+                                          const std::vector<KeyFrameId>& stored_keyframes,
+                                          const std::vector<KeyFrameId>& places_missing) {
   if (!options_.store) return;
   const std::string map =
       !config_.map_name.empty()
@@ -187,6 +199,7 @@ void SlamSessionBackend::startStoreWriter(std::optional<StoreSessionId> resumed,
     store_writer_ = std::make_unique<MapStoreWriter>(options_.store, session, mapping_->map(),
                                                      options_.store_stats);
     store_writer_->assumeStored(stored_keyframes);
+    store_writer_->storePlacesOf(places_missing);
     mapping_->setChangeObserver(store_writer_.get());
     spdlog::info("session {}: writing map '{}' to {}{}", config_.session_id, map,
                  options_.store->location(), resumed ? " (resumed)" : "");

@@ -49,7 +49,8 @@ class SlamSessionBackend : public EdgeSessionBackend {
   std::optional<StoredSession> storedSessionToResume();
   void makeMapping(std::optional<StoredSession> resumed);
   void startStoreWriter(std::optional<StoreSessionId> resumed,
-                        const std::vector<KeyFrameId>& stored_keyframes);
+                        const std::vector<KeyFrameId>& stored_keyframes,
+                        const std::vector<KeyFrameId>& places_missing);
   void publish(MapSlice slice);
 
   mutable std::mutex view_mutex_;  // guards making mapping_ and offload_, for the viewer

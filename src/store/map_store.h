@@ -15,6 +15,8 @@
 #include "geometry/camera.h"
 #include "map/map_records.h"
 #include "map/sensor.h"
+#include "place/bow_vector.h"
+#include "place/feature_vector.h"
 
 namespace edgeslam {
 
@@ -39,6 +41,17 @@ struct StoredSessionInfo {
 
 using StoreSessionId = std::int64_t;
 
+// A keyframe's bag of words and direct index (KeyFramePlace) as a vocabulary made them: stored so
+// that a map read back need not compute them again (~1.8 ms a keyframe), and used only with the
+// same vocabulary at the same direct-index depth.
+struct KeyFramePlaceRecord {
+  KeyFrameId keyframe = kInvalidId;
+  std::uint64_t vocabulary = 0;  // Vocabulary::checksum() of the one that made it
+  int direct_index_depth = 0;
+  BowVector bow;
+  FeatureVector features;
+};
+
 // One transaction's worth of changes of one session's map.
 struct MapStoreBatch {
   bool cleared = false;  // the session's map was emptied (a failed start) before what follows
@@ -49,11 +62,12 @@ struct MapStoreBatch {
   std::vector<MapPointRecord> points_moved;
   std::vector<MapPointId> points_erased;
   std::vector<KeyFrameId> keyframes_erased;
-  std::vector<MaskRecord> masks;  // semantic labels of keyframes
+  std::vector<MaskRecord> masks;            // semantic labels of keyframes
+  std::vector<KeyFramePlaceRecord> places;  // of keyframes stored (now or before)
   bool empty() const {
     return !cleared && keyframes.empty() && poses.empty() && points.empty() &&
            points_moved.empty() && points_erased.empty() && keyframes_erased.empty() &&
-           masks.empty();
+           masks.empty() && places.empty();
   }
 };
 
@@ -65,6 +79,7 @@ struct StoredSession {
   std::vector<KeyFrameRecord> keyframes;  // by id; point_ids filled from the observations
   std::vector<MapPointRecord> points;     // by id
   std::vector<MaskRecord> masks;
+  std::vector<KeyFramePlaceRecord> places;  // by keyframe; none in a store of schema version 1
 };
 
 struct StoredMap {

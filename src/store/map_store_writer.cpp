@@ -5,6 +5,7 @@
 #include <chrono>
 
 #include "map/map_replication.h"
+#include "place/vocabulary.h"
 
 namespace edgeslam {
 
@@ -68,6 +69,27 @@ void MapStoreWriter::assumeStored(const std::vector<KeyFrameId>& keyframes) {
   stored_keyframes_.insert(keyframes.begin(), keyframes.end());
 }
 
+void MapStoreWriter::storePlacesOf(const std::vector<KeyFrameId>& keyframes) {
+  std::lock_guard writing(write_mutex_);
+  awaiting_place_.insert(keyframes.begin(), keyframes.end());
+}
+
+bool MapStoreWriter::addPlace(const KeyFrame& keyframe, MapStoreBatch& batch) {
+  const std::shared_ptr<const KeyFramePlace> place = keyframe.place();
+  if (place == nullptr || place->vocabulary == nullptr) return false;
+  auto checksum = vocabulary_checksums_.find(place->vocabulary);
+  if (checksum == vocabulary_checksums_.end()) {
+    checksum =
+        vocabulary_checksums_.emplace(place->vocabulary, place->vocabulary->checksum()).first;
+  }
+  batch.places.push_back({.keyframe = keyframe.id(),
+                          .vocabulary = checksum->second,
+                          .direct_index_depth = place->direct_index_depth,
+                          .bow = place->bow,
+                          .features = place->features});
+  return true;
+}
+
 void MapStoreWriter::onMapCleared() {
   std::lock_guard lock(pending_mutex_);
   cleared_ = true;
@@ -115,7 +137,10 @@ MapStoreBatch MapStoreWriter::takeBatch() {
     points_moved.swap(points_moved_);
     batch.masks.swap(masks_);
   }
-  if (batch.cleared) stored_keyframes_.clear();
+  if (batch.cleared) {
+    stored_keyframes_.clear();
+    awaiting_place_.clear();
+  }
   // What the map holds now decides: an element changed and then erased is erased.
   std::lock_guard map_lock(map_.updateMutex());
   for (const KeyFrameId id : keyframes) {
@@ -124,8 +149,19 @@ MapStoreBatch MapStoreWriter::takeBatch() {
       if (stored_keyframes_.erase(id) > 0) batch.keyframes_erased.push_back(id);
     } else if (stored_keyframes_.insert(id).second) {
       batch.keyframes.push_back(keyFrameRecord(*keyframe));
+      // Mapping describes a keyframe soon after it arrives: usually before this copy.
+      if (!addPlace(*keyframe, batch)) awaiting_place_.insert(id);
     } else {
       batch.poses.push_back(keyFramePoseRecord(*keyframe));
+    }
+  }
+  for (auto it = awaiting_place_.begin(); it != awaiting_place_.end();) {
+    const KeyFrame* keyframe = map_.keyFrame(*it);
+    if (keyframe == nullptr || keyframe->isBad() || !stored_keyframes_.contains(*it) ||
+        addPlace(*keyframe, batch)) {
+      it = awaiting_place_.erase(it);
+    } else {
+      ++it;
     }
   }
   for (const MapPointId id : points) {
@@ -170,6 +206,7 @@ void MapStoreWriter::flush() {
     // The batch is lost (the transaction rolled back); later batches carry on so that at least
     // what changes again is kept. The keyframes it would have stored are sent in full again.
     for (const KeyFrameRecord& k : batch.keyframes) stored_keyframes_.erase(k.id);
+    for (const KeyFramePlaceRecord& p : batch.places) awaiting_place_.insert(p.keyframe);
     if (stats_) stats_->addFailure();
     spdlog::error("map store: {}", e.what());
   }

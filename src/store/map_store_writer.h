@@ -7,6 +7,7 @@
 #include <memory>
 #include <mutex>
 #include <thread>
+#include <unordered_map>
 #include <unordered_set>
 #include <vector>
 
@@ -64,6 +65,9 @@ class MapStoreWriter : public MapChangeObserver {
   // The session resumes a stored one: these keyframes are in the store already (later changes
   // update their poses or delete them instead of writing them whole). Call before any change.
   void assumeStored(const std::vector<KeyFrameId>& keyframes);
+  // Stored keyframes whose place (bag of words, direct index) the store lacks (a store of schema
+  // version 1): each is written once the keyframe has one.
+  void storePlacesOf(const std::vector<KeyFrameId>& keyframes);
 
   // Writes what is pending now (on the caller's thread) and waits for it.
   void flush();
@@ -73,6 +77,8 @@ class MapStoreWriter : public MapChangeObserver {
  private:
   void run();
   MapStoreBatch takeBatch();
+  // The keyframe's place as a record; false while it has none.
+  bool addPlace(const KeyFrame& keyframe, MapStoreBatch& batch);
 
   std::shared_ptr<MapStore> store_;
   StoreSessionId session_;
@@ -91,6 +97,9 @@ class MapStoreWriter : public MapChangeObserver {
 
   std::mutex write_mutex_;                           // one batch at a time
   std::unordered_set<KeyFrameId> stored_keyframes_;  // guarded by write_mutex_
+  // Stored keyframes not described yet when they were written (guarded by write_mutex_).
+  std::unordered_set<KeyFrameId> awaiting_place_;
+  std::unordered_map<const Vocabulary*, std::uint64_t> vocabulary_checksums_;  // write_mutex_
   bool stopped_ = false;
   std::thread thread_;
 };

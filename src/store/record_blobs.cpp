@@ -1,8 +1,11 @@
 #include "store/record_blobs.h"
 
 #include <bit>
+#include <cmath>
 #include <cstring>
+#include <limits>
 #include <type_traits>
+#include <utility>
 
 #include "store/store_error.h"
 
@@ -130,6 +133,65 @@ std::vector<PointObservationRecord> observationsFromBlob(const Blob& blob) {
     observations[i].keypoint_index = read<std::uint32_t>(blob, i * kObservationBytes + 8);
   }
   return observations;
+}
+
+Blob bowBlob(const BowVector& bow) {
+  Blob blob;
+  blob.reserve(bow.size() * (4 + 8));
+  for (const BowEntry& e : bow) {
+    append(blob, std::uint32_t{e.word});
+    append(blob, e.weight);
+  }
+  return blob;
+}
+
+BowVector bowFromBlob(const Blob& blob) {
+  checkSize(blob, 4 + 8, "bag of words");
+  BowVector bow;
+  bow.entries.reserve(blob.size() / 12);
+  for (std::size_t offset = 0; offset < blob.size(); offset += 12) {
+    BowEntry e{read<std::uint32_t>(blob, offset), read<double>(blob, offset + 4)};
+    if (!(std::isfinite(e.weight) && e.weight > 0.0) ||
+        (!bow.entries.empty() && e.word <= bow.entries.back().word)) {
+      throw StoreError("damaged bag of words blob (word " + std::to_string(e.word) + ")");
+    }
+    bow.entries.push_back(e);
+  }
+  return bow;
+}
+
+Blob featureVectorBlob(const FeatureVector& features) {
+  Blob blob;
+  blob.reserve(features.size() * 8 + features.featureCount() * 4);
+  for (std::size_t i = 0; i < features.size(); ++i) {
+    const auto indices = features.features(i);
+    append(blob, std::uint32_t{features.node(i)});
+    append(blob, static_cast<std::uint32_t>(indices.size()));
+    for (const int index : indices) append(blob, static_cast<std::uint32_t>(index));
+  }
+  return blob;
+}
+
+FeatureVector featureVectorFromBlob(const Blob& blob) {
+  std::vector<std::pair<NodeId, int>> pairs;
+  std::size_t offset = 0;
+  while (offset < blob.size()) {
+    if (blob.size() - offset < 8) throw StoreError("damaged direct index blob (truncated node)");
+    const auto node = read<std::uint32_t>(blob, offset);
+    const auto count = read<std::uint32_t>(blob, offset + 4);
+    offset += 8;
+    if ((blob.size() - offset) / 4 < count) {
+      throw StoreError("damaged direct index blob (node " + std::to_string(node) + ")");
+    }
+    for (std::uint32_t k = 0; k < count; ++k, offset += 4) {
+      const auto index = read<std::uint32_t>(blob, offset);
+      if (index > static_cast<std::uint32_t>(std::numeric_limits<int>::max())) {
+        throw StoreError("damaged direct index blob (feature " + std::to_string(index) + ")");
+      }
+      pairs.emplace_back(node, static_cast<int>(index));
+    }
+  }
+  return FeatureVector::fromPairs(std::move(pairs));
 }
 
 }  // namespace edgeslam

@@ -7,6 +7,8 @@
 #include <vector>
 
 #include "map/map_records.h"
+#include "place/bow_vector.h"
+#include "place/feature_vector.h"
 
 namespace edgeslam {
 
@@ -26,5 +28,13 @@ std::vector<float> floatsFromBlob(const Blob& blob);
 
 Blob observationsBlob(const std::vector<PointObservationRecord>& observations);
 std::vector<PointObservationRecord> observationsFromBlob(const Blob& blob);
+
+// 12 B a word: u32 word, f64 weight. Decoding keeps the order (words ascending, as written).
+Blob bowBlob(const BowVector& bow);
+BowVector bowFromBlob(const Blob& blob);
+
+// Per node: u32 node, u32 count, count x u32 feature index.
+Blob featureVectorBlob(const FeatureVector& features);
+FeatureVector featureVectorFromBlob(const Blob& blob);
 
 }  // namespace edgeslam

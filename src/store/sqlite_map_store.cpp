@@ -85,6 +85,21 @@ struct SqliteMapStore::Statements {
   SqliteStatement insert_point, move_point, erase_point, insert_mask;
 };
 
+// Schema version 2 on: what a writer keeps of keyframes' places (a reader may open a version 1
+// store, which has no such table).
+struct SqliteMapStore::PlaceStatements {
+  explicit PlaceStatements(SqliteDatabase& db)
+      : clear(db, "DELETE FROM keyframe_places WHERE session_id = ?"),
+        erase(db, "DELETE FROM keyframe_places WHERE session_id = ? AND keyframe = ?"),
+        // Only beside a stored keyframe: a place whose keyframe was erased meanwhile is dropped.
+        insert(db,
+               "INSERT OR REPLACE INTO keyframe_places(session_id, keyframe, vocabulary, "
+               "direct_index_depth, bow, direct_index) SELECT ?1, ?2, ?3, ?4, ?5, ?6 WHERE "
+               "EXISTS(SELECT 1 FROM keyframes WHERE session_id = ?1 AND id = ?2)") {}
+
+  SqliteStatement clear, erase, insert;
+};
+
 SqliteMapStore::SqliteMapStore(const std::filesystem::path& file, MapStoreAccess access,
                                int lock_fd)
     : lock_fd_(lock_fd),
@@ -119,6 +134,7 @@ SqliteMapStore::SqliteMapStore(const std::filesystem::path& file, MapStoreAccess
       prepareSchema(db_);
     }
     statements_ = std::make_unique<Statements>(db_);
+    if (schemaVersion(db_) >= 2) place_statements_ = std::make_unique<PlaceStatements>(db_);
   } catch (const std::exception& e) {
     throw StoreError(withFile(db_, e));
   }
@@ -126,6 +142,7 @@ SqliteMapStore::SqliteMapStore(const std::filesystem::path& file, MapStoreAccess
 
 SqliteMapStore::~SqliteMapStore() {
   statements_.reset();
+  place_statements_.reset();
   if (lock_fd_ >= 0) close(lock_fd_);
 }
 
@@ -184,6 +201,14 @@ MapSummary SqliteMapStore::summary(std::int64_t map_id, const std::string& name)
     SqliteStatement s(db_,
                       "SELECT coalesce(sum(length(bytes) + 24), 0) FROM masks WHERE session_id "
                       "IN (SELECT id FROM sessions WHERE map_id = ?)");
+    s.bind(1, map_id);
+    if (s.step()) out.bytes += static_cast<std::uint64_t>(s.columnInt(0));
+  }
+  if (place_statements_) {
+    SqliteStatement s(db_,
+                      "SELECT coalesce(sum(length(bow) + length(direct_index) + 24), 0) FROM "
+                      "keyframe_places WHERE session_id IN (SELECT id FROM sessions WHERE "
+                      "map_id = ?)");
     s.bind(1, map_id);
     if (s.step()) out.bytes += static_cast<std::uint64_t>(s.columnInt(0));
   }
@@ -294,6 +319,8 @@ StoredSession SqliteMapStore::loadSession(SqliteStatement& row) {
     session.points.push_back(std::move(p));
   }
 
+  if (place_statements_) loadPlaces(session, keyframe_index);
+
   SqliteStatement masks(db_,
                         "SELECT keyframe, width, height, encoding, bytes FROM masks WHERE "
                         "session_id = ? ORDER BY keyframe");
@@ -308,6 +335,35 @@ StoredSession SqliteMapStore::loadSession(SqliteStatement& row) {
     session.masks.push_back(std::move(m));
   }
   return session;
+}
+
+void SqliteMapStore::loadPlaces(StoredSession& session,
+                                const std::unordered_map<KeyFrameId, std::size_t>& keyframe_index) {
+  SqliteStatement places(db_,
+                         "SELECT keyframe, vocabulary, direct_index_depth, bow, direct_index FROM "
+                         "keyframe_places WHERE session_id = ? ORDER BY keyframe");
+  places.bind(1, session.id);
+  while (places.step()) {
+    KeyFramePlaceRecord p;
+    p.keyframe = fromSql(places.columnInt(0));
+    const auto it = keyframe_index.find(p.keyframe);
+    if (it == keyframe_index.end()) continue;  // its keyframe is gone
+    p.vocabulary = fromSql(places.columnInt(1));
+    p.direct_index_depth = static_cast<int>(places.columnInt(2));
+    p.bow = bowFromBlob(places.columnBlob(3));
+    p.features = featureVectorFromBlob(places.columnBlob(4));
+    const std::size_t keypoints = session.keyframes[it->second].features.keypoints.size();
+    for (std::size_t i = 0; i < p.features.size(); ++i) {
+      for (const int index : p.features.features(i)) {
+        if (static_cast<std::size_t>(index) >= keypoints) {
+          throw StoreError("damaged direct index of keyframe " + std::to_string(p.keyframe) +
+                           ": feature " + std::to_string(index) + " of " +
+                           std::to_string(keypoints));
+        }
+      }
+    }
+    session.places.push_back(std::move(p));
+  }
 }
 
 std::optional<StoredMap> SqliteMapStore::loadMap(const std::string& name) {
@@ -364,6 +420,7 @@ void SqliteMapStore::write(StoreSessionId session, const MapStoreBatch& batch) {
     s.clear_keyframes.bind(1, session).run();
     s.clear_points.bind(1, session).run();
     s.clear_masks.bind(1, session).run();
+    if (place_statements_) place_statements_->clear.bind(1, session).run();
   }
   for (const KeyFrameRecord& k : batch.keyframes) {
     SqliteStatement& q = s.insert_keyframe;
@@ -403,11 +460,20 @@ void SqliteMapStore::write(StoreSessionId session, const MapStoreBatch& batch) {
   for (const KeyFrameId id : batch.keyframes_erased) {
     s.erase_keyframe.bind(1, session).bind(2, toSql(id)).run();
     s.erase_mask.bind(1, session).bind(2, toSql(id)).run();
+    if (place_statements_) place_statements_->erase.bind(1, session).bind(2, toSql(id)).run();
   }
   for (const MaskRecord& m : batch.masks) {
     SqliteStatement& q = s.insert_mask;
     q.bind(1, session).bind(2, toSql(m.keyframe)).bind(3, std::int64_t{m.width});
     q.bind(4, std::int64_t{m.height}).bind(5, m.encoding).bindBlob(6, m.bytes).run();
+  }
+  if (place_statements_) {
+    for (const KeyFramePlaceRecord& p : batch.places) {
+      SqliteStatement& q = place_statements_->insert;
+      q.bind(1, session).bind(2, toSql(p.keyframe)).bind(3, toSql(p.vocabulary));
+      q.bind(4, std::int64_t{p.direct_index_depth}).bindBlob(5, bowBlob(p.bow));
+      q.bindBlob(6, featureVectorBlob(p.features)).run();
+    }
   }
   s.touch_map.bind(1, nowSeconds()).bind(2, session).run();
   transaction.commit();

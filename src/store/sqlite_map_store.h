@@ -4,6 +4,7 @@
 // mutex, so the writers of several sessions share the store.
 #include <memory>
 #include <mutex>
+#include <unordered_map>
 
 #include "store/map_store.h"
 #include "store/sqlite_database.h"
@@ -28,14 +29,18 @@ class SqliteMapStore : public MapStore {
 
  private:
   struct Statements;
+  struct PlaceStatements;
   std::optional<std::int64_t> mapId(const std::string& name);
   MapSummary summary(std::int64_t map_id, const std::string& name);
   StoredSession loadSession(SqliteStatement& row);
+  void loadPlaces(StoredSession& session,
+                  const std::unordered_map<KeyFrameId, std::size_t>& keyframe_index);
 
   std::mutex mutex_;
   int lock_fd_;
   SqliteDatabase db_;
   std::unique_ptr<Statements> statements_;
+  std::unique_ptr<PlaceStatements> place_statements_;  // nullptr in a version 1 store (read)
 };
 
 }  // namespace edgeslam

@@ -1,5 +1,6 @@
 #include "store/store_schema.h"
 
+#include <iterator>
 #include <string>
 
 #include "store/store_error.h"
@@ -10,6 +11,19 @@ namespace {
 int pragmaInt(SqliteDatabase& db, const char* pragma) {
   SqliteStatement statement(db, std::string("PRAGMA ") + pragma);
   return statement.step() ? static_cast<int>(statement.columnInt(0)) : 0;
+}
+
+void createKeyFramePlaces(SqliteDatabase& db) {
+  db.execute(R"sql(
+CREATE TABLE keyframe_places(
+  session_id INTEGER NOT NULL REFERENCES sessions(id) ON DELETE CASCADE,
+  keyframe INTEGER NOT NULL,
+  vocabulary INTEGER NOT NULL,
+  direct_index_depth INTEGER NOT NULL,
+  bow BLOB NOT NULL,
+  direct_index BLOB NOT NULL,
+  PRIMARY KEY(session_id, keyframe)) WITHOUT ROWID;
+)sql");
 }
 
 void createTables(SqliteDatabase& db) {
@@ -66,11 +80,14 @@ CREATE TABLE masks(
   bytes BLOB NOT NULL,
   PRIMARY KEY(session_id, keyframe)) WITHOUT ROWID;
 )sql");
+  createKeyFramePlaces(db);
 }
 
-// Migrations from version v to v + 1, in order; index 0 upgrades version 1. None yet.
+// Migrations from version v to v + 1, in order; index 0 upgrades version 1. Version 1 -> 2 adds
+// the keyframes' places (empty: keyframes stored before are described when they are loaded).
 using Migration = void (*)(SqliteDatabase&);
-constexpr Migration kMigrations[] = {nullptr};
+constexpr Migration kMigrations[] = {createKeyFramePlaces};
+static_assert(std::size(kMigrations) == kSchemaVersion - 1);
 
 int tableCount(SqliteDatabase& db) {
   SqliteStatement count(db, "SELECT count(*) FROM sqlite_master");
@@ -78,6 +95,10 @@ int tableCount(SqliteDatabase& db) {
 }
 
 }  // namespace
+
+int schemaVersion(SqliteDatabase& db) {
+  return pragmaInt(db, "user_version");
+}
 
 void checkSchema(SqliteDatabase& db, bool writable) {
   const std::string file = db.file().string();
@@ -100,7 +121,7 @@ void checkSchema(SqliteDatabase& db, bool writable) {
     throw StoreError(file + ": map store schema version " + std::to_string(version) +
                      " is unknown");
   }
-  if (version < kSchemaVersion && !writable) {
+  if (version < kOldestReadableSchemaVersion && !writable) {
     throw StoreError(file + ": map store schema version " + std::to_string(version) +
                      " needs migrating: open it once with `edgeslam server --maps`");
   }

@@ -7,7 +7,12 @@ namespace edgeslam {
 
 // Version 1: maps, sessions (with their camera), keyframes (pose, features as blobs), points
 // (position, appearance, observations as a blob), masks (semantic labels).
-constexpr int kSchemaVersion = 1;
+// Version 2: keyframe_places (each keyframe's bag of words and direct index, and the vocabulary
+// that made them).
+constexpr int kSchemaVersion = 2;
+// Readers (list, info, export) open stores of this version on without migrating them: what later
+// versions added is optional to them.
+constexpr int kOldestReadableSchemaVersion = 1;
 // "ESLM": tells an edgeslam store from any other SQLite file.
 constexpr int kStoreApplicationId = 0x45534c4d;
 
@@ -15,5 +20,7 @@ constexpr int kStoreApplicationId = 0x45534c4d;
 void checkSchema(SqliteDatabase& db, bool writable);
 // After checkSchema: creates the schema of a new store or migrates an older one.
 void prepareSchema(SqliteDatabase& db);
+// The store's schema version (PRAGMA user_version).
+int schemaVersion(SqliteDatabase& db);
 
 }  // namespace edgeslam

@@ -2,14 +2,35 @@
 // A stored session back into a Map, as a server resuming it would hold it: keyframes with their
 // features and poses, points with their observations and appearance; the covisibility graph and
 // spanning tree are rebuilt from the shared points (the stored parents are for exports). Bags of
-// words are not stored either: local mapping computes a keyframe's from its descriptors when it
-// needs it.
+// words and direct indices (places) are stored from schema version 2 on and attached when they
+// were made by the vocabulary in use; local mapping computes the others from the descriptors.
+#include <cstdint>
+#include <memory>
+#include <vector>
+
 #include "map/map.h"
+#include "place/vocabulary.h"
 #include "store/map_store.h"
 
 namespace edgeslam {
 
 // Into an empty map. Throws StoreError when the records contradict themselves.
 void loadStoredSession(const StoredSession& session, Map& map);
+
+struct AttachedPlaces {
+  std::size_t attached = 0;
+  std::vector<KeyFrameId> missing;  // keyframes of the map left without a place
+};
+
+// After loadStoredSession: each keyframe takes its stored place when `vocabulary` (whose
+// checksum() is `checksum`, computed once by the caller) made it at `direct_index_depth`. Throws
+// StoreError when a stored place names words or nodes the vocabulary does not have.
+AttachedPlaces attachStoredPlaces(const StoredSession& session, Map& map,
+                                  const Vocabulary& vocabulary, std::uint64_t checksum,
+                                  int direct_index_depth);
+
+// The keyframes' places as local mapping makes them (LocalMapper::describe), for those without
+// one; returns how many were computed.
+std::size_t describeKeyFrames(Map& map, const Vocabulary& vocabulary, int direct_index_depth);
 
 }  // namespace edgeslam

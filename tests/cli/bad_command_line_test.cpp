@@ -133,6 +133,9 @@ std::vector<BadInvocation> sweep(const BadInputs& in) {
       {"run --dataset " + tum + " --frames 10-5", kUsage},
       {"run --dataset " + tum + " --frames ten", kUsage},
       {"run --dataset " + tum + " --frames 5-500", kUsage},  // past the dataset's 20 frames
+      {"run --dataset " + tum + " --repeat 0", kUsage},
+      {"run --dataset " + tum + " --repeat two", kUsage},
+      {"run --dataset " + tum + " --repeat 2 --max-frames 10", kUsage},  // --frames A-B instead
       {"run --dataset " + tum + " --realtime --fast", kUsage},
       {"run --dataset " + tum + " --deterministic --realtime", kUsage},
       {"run --dataset " + tum + " --deterministic --mode edge", kUsage},
