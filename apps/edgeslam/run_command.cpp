@@ -315,9 +315,9 @@ int runPipeline(const RunOptions& given) {
   std::optional<LiveCamera> live_camera;
   if (options.realtime) {
     live_camera.emplace(*reader, frame_count,
-                   LiveCameraClock{.now_ms = [&wall] { return wall.elapsedMs(); },
-                                   .sleep_ms = steadyLiveCameraClock().sleep_ms},
-                   LiveCameraOptions{.extra_load_ms = testExtraLoadMs()});
+                        LiveCameraClock{.now_ms = [&wall] { return wall.elapsedMs(); },
+                                        .sleep_ms = steadyLiveCameraClock().sleep_ms},
+                        LiveCameraOptions{.extra_load_ms = testExtraLoadMs()});
   }
   std::size_t next_unpaced = 0;
   for (;;) {
@@ -473,7 +473,8 @@ int runPipeline(const RunOptions& given) {
                             {"frames_dropped_late", frames_dropped_late},
                             {"frames_skipped_late", frames_skipped_late},
                             {"frames_processed", frame_log.size()},
-                            {"frames_read", live_camera ? live_camera->read() : frame_count},
+                            {"frames_read", live_camera ? live_camera->reads() : frame_count},
+                            {"frames_read_unused", live_camera ? live_camera->unusedReads() : 0},
                             {"frames_out_of_order",
                              {{"skipped", frame_order.rejected()},
                               {"duplicate_timestamp", frame_order.duplicates()},

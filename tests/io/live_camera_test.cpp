@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
+#include <mutex>
 #include <stdexcept>
 #include <vector>
 
@@ -10,15 +12,19 @@ namespace {
 
 // A camera clock that moves only when someone sleeps or reads a frame.
 struct FakeClock {
-  double now = 0.0;
+  std::atomic<double> now = 0.0;
+  void advance(double ms) { now.store(now.load() + ms); }
   LiveCameraClock clock() {
-    return {.now_ms = [this] { return now; },
+    return {.now_ms = [this] { return now.load(); },
             .sleep_ms =
                 [this](double ms) {
-                  if (ms > 0.0) now += ms;
+                  if (ms > 0.0) advance(ms);
                 }};
   }
 };
+
+// Reading on the consumer's thread: each read moves the fake clock, deterministically.
+constexpr LiveCameraOptions kReadWhenTaken{.read_ahead = false};
 
 // Frames at 30 fps whose grey image is empty; each read costs `read_ms` on the fake clock and is
 // recorded, so a test sees which frames were decoded.
@@ -34,7 +40,8 @@ class ClockedReader : public DatasetReader {
   const std::vector<double>& timestamps() const override { return stamps_; }
   const std::vector<std::optional<SE3d>>& groundTruth() const override { return truth_; }
   DatasetFrame load(std::size_t index) override {
-    clock_.now += read_ms_;
+    clock_.advance(read_ms_);
+    const std::lock_guard lock(reads_mutex_);
     reads.push_back(index);
     DatasetFrame frame;
     frame.index = index;
@@ -58,6 +65,7 @@ class ClockedReader : public DatasetReader {
   std::vector<std::optional<SE3d>> truth_;
   FakeClock& clock_;
   double read_ms_;
+  std::mutex reads_mutex_;
 };
 
 constexpr double kPeriodMs = 1000.0 / 30.0;
@@ -109,7 +117,7 @@ TEST(LiveFrameSchedule, TimestampsGoingBackNeverRunTheClockBackwards) {
 TEST(LiveCamera, AFastClientGetsEveryFrameAtItsDueTime) {
   FakeClock clock;
   ClockedReader reader(10, clock, 5.0);
-  LiveCamera camera(reader, 10, clock.clock());
+  LiveCamera camera(reader, 10, clock.clock(), kReadWhenTaken);
   std::size_t expected = 0;
   while (auto frame = camera.grab()) {
     EXPECT_EQ(frame->index, expected);
@@ -117,7 +125,7 @@ TEST(LiveCamera, AFastClientGetsEveryFrameAtItsDueTime) {
     // Read in the wait before it was due, handed over at its time: the read is no latency.
     EXPECT_NEAR(clock.now, std::max(frame->due_ms, 5.0), 1e-9);
     EXPECT_NEAR(frame->load_ms, 5.0, 1e-9);
-    clock.now += 10.0;  // tracking, well inside the frame period
+    clock.advance(10.0);  // tracking, well inside the frame period
     ++expected;
   }
   EXPECT_EQ(expected, 10u);
@@ -128,7 +136,7 @@ TEST(LiveCamera, AFastClientGetsEveryFrameAtItsDueTime) {
 TEST(LiveCamera, AStarvedClientSkipsToTheNewestDueFrameAndNeverReadsTheSkippedOnes) {
   FakeClock clock;
   ClockedReader reader(100, clock, 5.0);
-  LiveCamera camera(reader, 100, clock.clock());
+  LiveCamera camera(reader, 100, clock.clock(), kReadWhenTaken);
   std::size_t handed_over = 0, last = 0;
   double worst_latency_ms = 0.0;
   for (;;) {
@@ -147,7 +155,7 @@ TEST(LiveCamera, AStarvedClientSkipsToTheNewestDueFrameAndNeverReadsTheSkippedOn
       EXPECT_LE(frame->due_ms, came_back_ms);
     }
     EXPECT_EQ(frame->index, handed_over == 0 ? 0 : last + 1 + frame->skipped);
-    clock.now += 80.0;  // tracking takes 2.4 frame periods
+    clock.advance(80.0);  // tracking takes 2.4 frame periods
     worst_latency_ms = std::max(worst_latency_ms, clock.now - frame->due_ms);
     last = frame->index;
     ++handed_over;
@@ -155,7 +163,7 @@ TEST(LiveCamera, AStarvedClientSkipsToTheNewestDueFrameAndNeverReadsTheSkippedOn
   // Every frame is either handed over or skipped, and only handed-over frames were read.
   EXPECT_EQ(handed_over + camera.skipped(), 100u);
   EXPECT_EQ(reader.reads.size(), handed_over);
-  EXPECT_EQ(camera.read(), handed_over);
+  EXPECT_EQ(camera.reads(), handed_over);
   EXPECT_GT(camera.skipped(), 50u);
   // Bounded: at most one frame period behind when it is taken, plus the read and the tracking.
   EXPECT_LE(worst_latency_ms, kPeriodMs + 5.0 + 80.0 + 1e-9);
@@ -164,14 +172,54 @@ TEST(LiveCamera, AStarvedClientSkipsToTheNewestDueFrameAndNeverReadsTheSkippedOn
 TEST(LiveCamera, ASlowReaderKeepsTheLatencyBounded) {
   FakeClock clock;
   ClockedReader reader(200, clock, 60.0);  // reading alone takes 1.8 frame periods
-  LiveCamera camera(reader, 200, clock.clock());
+  LiveCamera camera(reader, 200, clock.clock(), kReadWhenTaken);
   double worst_latency_ms = 0.0;
   while (auto frame = camera.grab()) {
-    clock.now += 10.0;
+    clock.advance(10.0);
     worst_latency_ms = std::max(worst_latency_ms, clock.now - frame->due_ms);
   }
   EXPECT_GT(camera.skipped(), 100u);
   EXPECT_LE(worst_latency_ms, kPeriodMs + 60.0 + 10.0 + 1e-9);
+}
+
+// Read ahead on its own thread (reads take no fake time here, so the clock stays the test's): after
+// the first late frame, the frame read ahead is the one due when the consumer comes back.
+TEST(LiveCamera, ReadingAheadPredictsTheNewestDueFrame) {
+  FakeClock clock;
+  ClockedReader reader(100, clock, 0.0);
+  LiveCamera camera(reader, 100, clock.clock());
+  std::size_t handed_over = 0;
+  for (;;) {
+    const double came_back_ms = clock.now.load();
+    const std::optional<LiveFrame> frame = camera.grab();
+    if (!frame) break;
+    if (frame->index + 1 < 100) {
+      EXPECT_GT(camera.schedule().dueMs(frame->index + 1), came_back_ms) << frame->index;
+    }
+    clock.advance(80.0);
+    ++handed_over;
+  }
+  EXPECT_EQ(handed_over + camera.skipped(), 100u);
+  EXPECT_GT(camera.skipped(), 50u);
+  // One read in vain, before the consumer's pace was known.
+  EXPECT_EQ(camera.unusedReads(), 1u);
+  EXPECT_EQ(camera.reads(), handed_over + camera.unusedReads());
+  EXPECT_EQ(reader.reads.size(), camera.reads());
+}
+
+TEST(LiveCamera, ReadingAheadGivesAFastConsumerEveryFrame) {
+  FakeClock clock;
+  ClockedReader reader(30, clock, 0.0);
+  LiveCamera camera(reader, 30, clock.clock());
+  std::size_t expected = 0;
+  while (auto frame = camera.grab()) {
+    EXPECT_EQ(frame->index, expected++);
+    EXPECT_NEAR(clock.now.load(), frame->due_ms, 1e-9);
+    clock.advance(10.0);
+  }
+  EXPECT_EQ(expected, 30u);
+  EXPECT_EQ(camera.unusedReads(), 0u);
+  EXPECT_EQ(camera.reads(), 30u);
 }
 
 TEST(LiveCamera, AReadErrorReachesTheConsumer) {
@@ -182,8 +230,10 @@ TEST(LiveCamera, AReadErrorReachesTheConsumer) {
   };
   FakeClock clock;
   FailingReader reader(3, clock, 1.0);
-  LiveCamera camera(reader, 3, clock.clock());
+  LiveCamera camera(reader, 3, clock.clock(), kReadWhenTaken);
   EXPECT_THROW(camera.grab(), DatasetError);
+  LiveCamera reading_ahead(reader, 3, clock.clock());
+  EXPECT_THROW(reading_ahead.grab(), DatasetError);
 }
 
 }  // namespace

@@ -49,8 +49,10 @@ TEST(LiveCameraCommand, AStarvedRealtimeClientSkipsToTheNewestFrameAndStaysBound
   EXPECT_EQ(skipped + processed + metrics["frames_out_of_order"]["skipped"].get<std::size_t>(),
             300u);
   EXPECT_EQ(metrics["frames_dropped_late"].get<std::size_t>(), skipped);
-  // Skipped frames were never read.
-  EXPECT_EQ(metrics["frames_read"].get<std::size_t>(), processed);
+  // Skipped frames were not read, but for a frame read ahead in vain now and then.
+  EXPECT_EQ(metrics["frames_read"].get<std::size_t>(),
+            processed + metrics["frames_read_unused"].get<std::size_t>());
+  EXPECT_LE(metrics["frames_read_unused"].get<std::size_t>(), processed / 10);
   // Bounded: one period of waiting, the 60 ms read and tracking, with room for a loaded host;
   // the in-order reader ended seconds behind.
   EXPECT_LT(metrics["e2e_ms"]["p95"].get<double>(), 400.0) << metrics["e2e_ms"].dump();
