@@ -253,6 +253,17 @@ int runPipeline(const RunOptions& given) {
     slam_options.mapper.triangulation_search =
         *parseTriangulationSearch(*options.triangulation_search);
   }
+  if (options.deterministic) {
+    if (mode != "local") {
+      throw CLI::ValidationError("--deterministic",
+                                 "applies to --mode local only (edge and offload runs cross "
+                                 "processes or threads that are not in lock-step)");
+    }
+    // The back end runs inside the tracking thread, after each frame; OpenCV's pool stays out of
+    // feature extraction so nothing depends on the order threads finish in.
+    slam_options.threaded_mapping = false;
+    cv::setNumThreads(1);
+  }
   if (options.refine_intrinsics && mode != "local") {
     spdlog::warn("--refine-intrinsics applies to --mode local only; the {} run keeps the camera",
                  mode);
@@ -306,6 +317,7 @@ int runPipeline(const RunOptions& given) {
   Stopwatch wall;
   Trajectory ground_truth;
   std::size_t tracked = 0, lost = 0;
+  std::size_t tracked_in_discarded_maps = 0, resets_seen = 0;
   FrameOrderGuard frame_order;
   std::optional<SemanticEvaluation> semantic_eval = SemanticEvaluation::open(info.path);
   if (semantic_eval) spdlog::info("ground-truth masks found: scoring the semantic culling");
@@ -373,6 +385,12 @@ int runPipeline(const RunOptions& given) {
       ++tracked;
     } else if (result.state == TrackingState::kLost) {
       ++lost;
+    }
+    if (slam.mapResets() != resets_seen) {
+      // A reset withdraws every pose of the map it discards: they leave `tracked`.
+      resets_seen = slam.mapResets();
+      tracked_in_discarded_maps += tracked;
+      tracked = 0;
     }
     const double fps = static_cast<double>(i + 1) / std::max(1e-9, wall.elapsedMs() / 1000.0);
     const std::size_t keyframes = slam.keyFrameCount();
@@ -463,6 +481,7 @@ int runPipeline(const RunOptions& given) {
                             {"tracking_recoveries", slam.trackingRecoveries()},
                             {"keyframe_decisions", keyFrameDecisionsJson(slam.keyFrameDecisions())},
                             {"map_resets", slam.mapResets()},
+                            {"tracked_in_discarded_maps", tracked_in_discarded_maps},
                             {"mode", mode},
                             {"requested_mode", options.mode},
                             {"sensor", sensor_name},
@@ -470,6 +489,7 @@ int runPipeline(const RunOptions& given) {
                             {"dataset_frames", frameRangeJson(options.frames, frame_count)},
                             {"wall_s", seconds},
                             {"pacing", options.realtime ? "realtime" : "fast"},
+                            {"deterministic", options.deterministic},
                             {"frames_dropped_late", frames_dropped_late},
                             {"frames_skipped_late", frames_skipped_late},
                             {"frames_processed", frame_log.size()},
@@ -572,8 +592,11 @@ int runPipeline(const RunOptions& given) {
   fmt::print("\nSummary\n");
   fmt::print("  dataset      {} ({})\n", info.path.string(), toString(info.format));
   fmt::print("  mode/sensor  {} / {}\n", mode, sensor_name);
-  fmt::print("  frames       {} in {:.2f} s ({:.1f} fps), tracked {}, lost {}\n", frame_count,
-             seconds, static_cast<double>(frame_count) / std::max(seconds, 1e-9), tracked, lost);
+  fmt::print("  frames       {} in {:.2f} s ({:.1f} fps), tracked {}, lost {}{}\n", frame_count,
+             seconds, static_cast<double>(frame_count) / std::max(seconds, 1e-9), tracked, lost,
+             tracked_in_discarded_maps == 0
+                 ? std::string()
+                 : fmt::format(" ({} more tracked in a discarded map)", tracked_in_discarded_maps));
   fmt::print(
       "  map          {} keyframes, {} points, {} relocalisations, {} recoveries, {} resets\n",
       slam.keyFrameCount(), slam.mapPointCount(), slam.relocalizations(), slam.trackingRecoveries(),
@@ -745,6 +768,10 @@ void addRunOptions(CLI::App* run, const std::shared_ptr<RunOptions>& options) {
   auto* realtime = run->add_flag("--realtime", options->realtime,
                                  "Feed frames at the dataset's rate, dropping none");
   run->add_flag("--fast", options->fast, "Feed frames as fast as possible (the default)")
+      ->excludes(realtime);
+  run->add_flag("--deterministic", options->deterministic,
+                "Local mode: map each keyframe (and close loops) before the next frame, on one "
+                "thread, so two runs give the same trajectory (for tests and bisecting; slower)")
       ->excludes(realtime);
   run->add_option("--out", options->out_dir,
                   "Output folder (trajectories, metrics.json, frames.csv with each frame's times)");

@@ -111,10 +111,10 @@ int runServer(const ServerOptions& o) {
   server.shutdown();
   const ClosedSessionTotals closed = server.closedSessions();
   spdlog::info(
-      "closed sessions: {} ({} by their client, {} idle, {} reclaimed, {} at shutdown); {} "
-      "keyframes received, {} uploads missing; {} of {} slices never acknowledged",
+      "closed sessions: {} ({} by their client, {} idle, {} reclaimed, {} at shutdown, {} failed); "
+      "{} keyframes received, {} uploads missing; {} of {} slices never acknowledged",
       closed.sessions, closed.closed_by_client, closed.closed_idle, closed.closed_reclaimed,
-      closed.closed_at_shutdown, closed.keyframes, closed.missing_uploads,
+      closed.closed_at_shutdown, closed.closed_failed, closed.keyframes, closed.missing_uploads,
       closed.slices_unacknowledged, closed.slices_pushed);
   write_metrics();
   return 0;

@@ -37,6 +37,7 @@ nlohmann::json serverMetricsJson(const EdgeServer& server, double uptime_s) {
             {"idle", c.closed_idle},
             {"reclaimed", c.closed_reclaimed},
             {"at_shutdown", c.closed_at_shutdown},
+            {"failed", c.closed_failed},
             {"keyframes", c.keyframes},
             {"duplicate_uploads", c.duplicate_uploads},
             {"missing_uploads", c.missing_uploads},

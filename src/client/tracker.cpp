@@ -197,7 +197,8 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
       if (sink_ != nullptr) sink_->onMapReset();
       resetMap();
       record(frame, false);
-      result.state = state_;
+      // This frame was lost (and counted so); the next one starts the new map.
+      result.state = TrackingState::kLost;
       return result;
     }
   }
@@ -453,7 +454,9 @@ void Tracker::updateLocalMap(const Frame& frame) {
   int best_count = 0;
   for (const auto& [kf, count] : counter) {
     if (kf->isBad()) continue;
-    if (count > best_count) {
+    // Ties go to the newer keyframe: the map's iteration order follows addresses, which differ
+    // from run to run.
+    if (count > best_count || (count == best_count && best != nullptr && kf->id() > best->id())) {
       best_count = count;
       best = kf;
     }

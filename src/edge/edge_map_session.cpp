@@ -326,6 +326,15 @@ void EdgeMapSession::finish() {
   if (loop_closer_) loop_closer_->waitUntilIdle();
 }
 
+std::optional<std::string> EdgeMapSession::failure() const {
+  if (auto cause = mapper_->failure()) return cause;
+  if (loop_closer_) {
+    if (auto cause = loop_closer_->failure()) return cause;
+  }
+  if (segmentation_) return segmentation_->failure();
+  return std::nullopt;
+}
+
 EdgeMapSessionStats EdgeMapSession::stats() const {
   std::lock_guard state(state_mutex_);
   return stats_;

@@ -90,6 +90,9 @@ class EdgeMapSession {
   void stop();
 
   EdgeMapSessionStats stats() const;
+  // Why one of the session's workers (mapping, loop closing, segmentation) ended with an
+  // exception: the session is over. nullopt while they run.
+  std::optional<std::string> failure() const;
   Map& map() { return map_; }
   // The keyframes the client holds (lock the map's update mutex while reading).
   const ClientMapWindow& clientWindow() const { return window_; }

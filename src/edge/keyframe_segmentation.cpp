@@ -10,8 +10,16 @@ KeyFrameSegmentationWorker::KeyFrameSegmentationWorker(std::shared_ptr<Segmenter
                                                        Done done, std::size_t max_queued)
     : segmenter_(std::move(segmenter)),
       done_(std::move(done)),
-      max_queued_(std::max<std::size_t>(1, max_queued)),
-      thread_([this] { run(); }) {}
+      max_queued_(std::max<std::size_t>(1, max_queued)) {
+  thread_.start(
+      "keyframe segmentation", [this] { run(); },
+      [this](const std::string&) {
+        MutexLock lock(mutex_);
+        stopping_ = true;
+        busy_ = false;
+        idle_.notify_all();
+      });
+}
 
 KeyFrameSegmentationWorker::~KeyFrameSegmentationWorker() {
   stop();
@@ -45,7 +53,7 @@ void KeyFrameSegmentationWorker::stop() {
     wake_.notify_all();
     idle_.notify_all();
   }
-  if (thread_.joinable()) thread_.join();
+  thread_.join();
 }
 
 KeyFrameSegmentationCounters KeyFrameSegmentationWorker::counters() const {

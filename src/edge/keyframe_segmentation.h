@@ -14,6 +14,7 @@
 #include "semantic/segmenter.h"
 #include "util/mutex.h"
 #include "util/timing_stats.h"
+#include "util/worker_thread.h"
 
 namespace edgeslam {
 
@@ -58,6 +59,9 @@ class KeyFrameSegmentationWorker {
   void waitUntilIdle();
   void stop();
   KeyFrameSegmentationCounters counters() const;
+  // Why the worker thread ended with an exception (a failed segmentation of one keyframe is
+  // counted, not this); nullopt if it did not.
+  std::optional<std::string> failure() const { return thread_.failure(); }
 
  private:
   void run();
@@ -76,7 +80,7 @@ class KeyFrameSegmentationWorker {
   std::size_t skipped_ GUARDED_BY(mutex_) = 0;
   std::size_t failed_ GUARDED_BY(mutex_) = 0;
   SampleStats segmentation_ms_ GUARDED_BY(mutex_);
-  std::thread thread_;
+  WorkerThread thread_;
 };
 
 }  // namespace edgeslam

@@ -8,6 +8,7 @@
 
 #include "map/map_matching.h"
 #include "map/pair_triangulation.h"
+#include "util/failpoint.h"
 #include "util/thread_priority.h"
 
 namespace edgeslam {
@@ -41,7 +42,15 @@ LocalMapper::~LocalMapper() {
 void LocalMapper::start() {
   if (thread_.joinable()) return;
   stopping_ = false;
-  thread_ = std::thread([this] { run(); });
+  thread_.start(
+      "local mapping", [this] { run(); },
+      [this](const std::string&) {
+        std::lock_guard lock(queue_mutex_);
+        failed_ = true;
+        busy_ = false;
+        queue_.clear();
+        idle_cv_.notify_all();
+      });
 }
 
 void LocalMapper::stop() {
@@ -51,12 +60,13 @@ void LocalMapper::stop() {
   }
   abort_ba_ = true;
   queue_cv_.notify_all();
-  if (thread_.joinable()) thread_.join();
+  thread_.join();
 }
 
 void LocalMapper::insertKeyFrame(KeyFrame* keyframe) {
   {
     std::lock_guard lock(queue_mutex_);
+    if (failed_) return;
     queue_.push_back(keyframe);
   }
   abort_ba_ = true;  // a running local BA gives way to the new keyframe
@@ -65,7 +75,7 @@ void LocalMapper::insertKeyFrame(KeyFrame* keyframe) {
 
 bool LocalMapper::acceptsKeyFrames() const {
   std::lock_guard lock(queue_mutex_);
-  return queue_.size() < options_.max_queue;
+  return !failed_ && queue_.size() < options_.max_queue;
 }
 
 void LocalMapper::onMapReset() {
@@ -106,7 +116,7 @@ void LocalMapper::waitUntilIdle() {
     return;
   }
   std::unique_lock lock(queue_mutex_);
-  idle_cv_.wait(lock, [this] { return queue_.empty() && !busy_; });
+  idle_cv_.wait(lock, [this] { return failed_ || (queue_.empty() && !busy_); });
 }
 
 void LocalMapper::processAll() {
@@ -146,6 +156,7 @@ void LocalMapper::run() {
 }
 
 void LocalMapper::processKeyFrame(KeyFrame* keyframe) {
+  failpoint("local_mapping");
   mapKeyFrame(keyframe);
   {
     std::lock_guard lock(stats_mutex_);

@@ -21,6 +21,7 @@
 #include "map/pair_triangulation.h"
 #include "optimize/map_optimization.h"
 #include "place/vocabulary.h"
+#include "util/worker_thread.h"
 
 namespace edgeslam {
 
@@ -82,6 +83,8 @@ class LocalMapper : public KeyFrameSink {
   ~LocalMapper() override;
 
   // Runs on its own thread until stop(); without start(), call processAll() to map synchronously.
+  // An exception on the thread ends it: failure() says why, keyframes are no longer taken and
+  // waitUntilIdle() returns (the owner ends its session or run).
   void start();
   void stop();
   void processAll();
@@ -95,6 +98,7 @@ class LocalMapper : public KeyFrameSink {
   void onMapReset() override;
 
   LocalMapperStats stats() const;
+  std::optional<std::string> failure() const { return thread_.failure(); }
 
   // Loop closing: stops mapping between keyframes (a running local BA is aborted) until resume().
   // Returns once the mapping thread is idle; without a thread there is nothing to wait for.
@@ -130,7 +134,8 @@ class LocalMapper : public KeyFrameSink {
   bool busy_ = false;
   bool stopping_ = false;
   bool paused_ = false;
-  std::thread thread_;
+  bool failed_ = false;
+  WorkerThread thread_;
 
   std::atomic<bool> abort_ba_{false};
   std::atomic<bool> reset_requested_{false};

@@ -37,7 +37,15 @@ void LoopCloser::start() {
     MutexLock lock(queue_mutex_);
     stopping_ = false;
   }
-  thread_ = std::thread([this] { run(); });
+  thread_.start(
+      "loop closing", [this] { run(); },
+      [this](const std::string&) {
+        MutexLock lock(queue_mutex_);
+        failed_ = true;
+        busy_ = false;
+        queue_.clear();
+        idle_cv_.notify_all();
+      });
 }
 
 void LoopCloser::stop() {
@@ -46,13 +54,14 @@ void LoopCloser::stop() {
     stopping_ = true;
   }
   queue_cv_.notify_all();
-  if (thread_.joinable()) thread_.join();
+  thread_.join();
   stopGlobalBundleAdjustment();
 }
 
 void LoopCloser::insertKeyFrame(KeyFrame* keyframe) {
   {
     MutexLock lock(queue_mutex_);
+    if (failed_) return;
     queue_.push_back(keyframe);
   }
   queue_cv_.notify_one();
@@ -98,10 +107,17 @@ void LoopCloser::waitUntilIdle() {
     if (!options_.threaded) processAll();
   } else {
     MutexLock lock(queue_mutex_);
-    lock.wait(idle_cv_, [this]() REQUIRES(queue_mutex_) { return queue_.empty() && !busy_; });
+    lock.wait(idle_cv_,
+              [this]() REQUIRES(queue_mutex_) { return failed_ || (queue_.empty() && !busy_); });
   }
   MutexLock lock(global_ba_mutex_);
-  if (global_ba_thread_.joinable()) global_ba_thread_.join();
+  global_ba_thread_.join();
+}
+
+std::optional<std::string> LoopCloser::failure() const {
+  if (auto cause = thread_.failure()) return cause;
+  MutexLock lock(global_ba_mutex_);
+  return global_ba_thread_.failure();
 }
 
 void LoopCloser::run() {
@@ -239,7 +255,7 @@ void LoopCloser::launchGlobalBundleAdjustment() {
   MutexLock lock(global_ba_mutex_);
   cancel_global_ba_ = false;
   if (options_.threaded) {
-    global_ba_thread_ = std::thread([this] { globalBundleAdjustment(); });
+    global_ba_thread_.start("global bundle adjustment", [this] { globalBundleAdjustment(); });
   } else {
     globalBundleAdjustment();
   }

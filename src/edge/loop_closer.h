@@ -23,6 +23,7 @@
 #include "map/sensor.h"
 #include "place/vocabulary.h"
 #include "util/mutex.h"
+#include "util/worker_thread.h"
 
 namespace edgeslam {
 
@@ -103,6 +104,8 @@ class LoopCloser {
 
   std::size_t loops() const { return loops_.load(); }
   LoopCloserStats stats() const;
+  // Why the loop-closing thread (or a global BA thread) ended with an exception; nullopt if not.
+  std::optional<std::string> failure() const;
 
  private:
   void run();
@@ -125,11 +128,13 @@ class LoopCloser {
   std::deque<KeyFrame*> queue_ GUARDED_BY(queue_mutex_);
   bool busy_ GUARDED_BY(queue_mutex_) = false;
   bool stopping_ GUARDED_BY(queue_mutex_) = false;
-  std::thread thread_;
+  bool failed_ GUARDED_BY(queue_mutex_) = false;
+  WorkerThread thread_;
   std::atomic<bool> reset_requested_{false};
 
-  Mutex global_ba_mutex_;  // guards global_ba_thread_ (launched and joined from two threads)
-  std::thread global_ba_thread_ GUARDED_BY(global_ba_mutex_);
+  mutable Mutex
+      global_ba_mutex_;  // guards global_ba_thread_ (launched and joined from two threads)
+  WorkerThread global_ba_thread_ GUARDED_BY(global_ba_mutex_);
   std::atomic<bool> cancel_global_ba_{false};
 
   std::atomic<std::size_t> loops_{0};

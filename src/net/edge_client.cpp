@@ -349,7 +349,11 @@ struct EdgeClient::Impl {
         return finishUpload(Outcome::kSent, which);
       }
       if (isStopping()) return finishUpload(Outcome::kDiscarded, which);
-      if (status.error_code() == grpc::StatusCode::NOT_FOUND) {
+      if (status.error_code() == grpc::StatusCode::ABORTED) {
+        spdlog::error("edge client: {}", status.error_message());
+      }
+      if (status.error_code() == grpc::StatusCode::NOT_FOUND ||
+          status.error_code() == grpc::StatusCode::ABORTED) {
         reconnecting.store(true);
         if (reopenSession(session, "keyframe upload: " + status.error_message())) continue;
       } else if (isPermanent(status.error_code())) {
@@ -410,10 +414,13 @@ struct EdgeClient::Impl {
       const grpc::StatusCode code = status.error_code();
       // The stream breaks at once when the server goes: uploads would only notice at their
       // deadline.
-      if (code == grpc::StatusCode::UNAVAILABLE || code == grpc::StatusCode::NOT_FOUND) {
+      if (code == grpc::StatusCode::UNAVAILABLE || code == grpc::StatusCode::NOT_FOUND ||
+          code == grpc::StatusCode::ABORTED) {
         reconnecting.store(true);
       }
-      if (code == grpc::StatusCode::NOT_FOUND) {
+      if (code == grpc::StatusCode::ABORTED)
+        spdlog::error("edge client: {}", status.error_message());
+      if (code == grpc::StatusCode::NOT_FOUND || code == grpc::StatusCode::ABORTED) {
         if (reopenSession(session, "slice stream: " + status.error_message())) continue;
       } else if (code == grpc::StatusCode::OUT_OF_RANGE) {
         spdlog::warn("edge client: slice stream: {}", status.error_message());
@@ -595,11 +602,16 @@ std::optional<OffloadResult> EdgeClient::offloadFrame(const OffloadFrame& frame)
         throw EdgeClientError(fmt::format("malformed offload reply: {}", e.what()));
       }
     }
-    if (status.error_code() == grpc::StatusCode::NOT_FOUND && attempt == 0 &&
+    const bool session_gone = status.error_code() == grpc::StatusCode::NOT_FOUND ||
+                              status.error_code() == grpc::StatusCode::ABORTED;
+    if (status.error_code() == grpc::StatusCode::ABORTED) {
+      spdlog::error("edge client: {}", status.error_message());
+    }
+    if (session_gone && attempt == 0 &&
         impl_->reopenSession(session, "frame offload: " + status.error_message())) {
       continue;
     }
-    if (isPermanent(status.error_code()) || status.error_code() == grpc::StatusCode::NOT_FOUND) {
+    if (isPermanent(status.error_code()) || session_gone) {
       throw EdgeClientError(fmt::format("frame {} rejected by the edge server: {}",
                                         frame.frame_index, describe(status)));
     }

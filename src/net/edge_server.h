@@ -38,6 +38,10 @@ class EdgeSessionBackend {
   // Ids of the session's id origin that its map already holds (a stored map loaded), up to this
   // one; 0 = none. Told to the client when the session opens.
   virtual std::uint64_t idFloor() const { return 0; }
+  // Why the session's back end can go on no more (a worker thread ended with an exception);
+  // nullopt while it works. Any thread, any time: the server asks before each call and ends a
+  // failed session (ABORTED to its client, the cause in its log and metrics).
+  virtual std::optional<std::string> failure() const { return std::nullopt; }
 };
 
 class EdgeSessionFactory {
@@ -93,6 +97,7 @@ struct ClosedSessionTotals {
   std::uint64_t closed_idle = 0;       // the client went silent for the idle timeout
   std::uint64_t closed_reclaimed = 0;  // unused, closed to make room for a new session
   std::uint64_t closed_at_shutdown = 0;
+  std::uint64_t closed_failed = 0;  // a worker of the session's back end failed (logged cause)
   std::uint64_t keyframes = 0;
   std::uint64_t duplicate_uploads = 0;
   std::uint64_t missing_uploads = 0;

@@ -111,7 +111,24 @@ grpc::Status EdgeService::findSession(const grpc::ServerContext& context,
     return {grpc::StatusCode::PERMISSION_DENIED,
             fmt::format("session {:#x} belongs to another client", header.session_id())};
   }
+  if (grpc::Status status = endIfFailed(**session); !status.ok()) {
+    session->reset();
+    return status;
+  }
   return grpc::Status::OK;
+}
+
+grpc::Status EdgeService::endIfFailed(const ServerSession& session) const {
+  const std::optional<std::string> cause = session.backend->failure();
+  if (!cause) return grpc::Status::OK;
+  const std::uint64_t id = session.config.session_id;
+  // Only this session ends: the server and every other session go on.
+  if (registry_.closeFailed(id)) {
+    spdlog::error("edge server: session {:#x} ('{}') ended: {}", id, session.config.client_name,
+                  *cause);
+  }
+  return {grpc::StatusCode::ABORTED,
+          fmt::format("session {:#x} ended on the edge: {}; open a new session", id, *cause)};
 }
 
 grpc::Status EdgeService::OpenSession(grpc::ServerContext* context,
@@ -261,6 +278,7 @@ grpc::Status EdgeService::StreamSlices(grpc::ServerContext* context,
     const SliceQueue::WaitResult result = session->slices.waitFrom(next, limits_.stream_poll);
     switch (result.status) {
       case SliceQueue::WaitStatus::kTimeout:
+        if (grpc::Status status = endIfFailed(*session); !status.ok()) return status;
         session->touch();
         continue;
       case SliceQueue::WaitStatus::kClosed:

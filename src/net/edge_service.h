@@ -41,6 +41,8 @@ class EdgeService final : public v1::EdgeSlam::Service {
   // The header's session, when it exists and belongs to the caller.
   grpc::Status findSession(const grpc::ServerContext& context, const v1::RequestHeader& header,
                            std::shared_ptr<ServerSession>* session) const;
+  // ABORTED, and the session closed, when its back end failed (EdgeSessionBackend::failure()).
+  grpc::Status endIfFailed(const ServerSession& session) const;
   // RESOURCE_EXHAUSTED when the session sends uploads or frames faster than its limit.
   grpc::Status admitUpload(ServerSession& session) const;
 

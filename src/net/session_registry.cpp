@@ -198,6 +198,9 @@ void SessionRegistry::account(const ServerSession& s, CloseReason reason) {
       case CloseReason::kShutdown:
         ++t.closed_at_shutdown;
         break;
+      case CloseReason::kFailed:
+        ++t.closed_failed;
+        break;
     }
     t.keyframes += s.keyframes.load();
     t.duplicate_uploads += s.duplicate_uploads.load();
@@ -213,7 +216,8 @@ void SessionRegistry::account(const ServerSession& s, CloseReason reason) {
     return;  // EdgeService logs the close
   }
   static constexpr const char* kReasons[] = {"by its client", "idle (its client went silent)",
-                                             "to make room", "at shutdown"};
+                                             "to make room", "at shutdown",
+                                             "after its back end failed"};
   spdlog::warn(
       "edge server: session {:#x} ('{}') closed {}: {} keyframes received, {} uploads missing, "
       "{} duplicate; {} of {} slices never acknowledged ({} dropped unacknowledged)",

@@ -81,6 +81,8 @@ class SessionRegistry {
   std::shared_ptr<ServerSession> find(std::uint64_t session_id) const;
   // Removes the session and closes its slice queue; false when unknown.
   bool close(std::uint64_t session_id) { return close(session_id, CloseReason::kByClient); }
+  // Ends a session whose back end failed (EdgeSessionBackend::failure()); false when unknown.
+  bool closeFailed(std::uint64_t session_id) { return close(session_id, CloseReason::kFailed); }
   // Closes sessions without an open stream whose last activity is older than `idle_timeout`.
   std::size_t closeIdle(std::chrono::milliseconds idle_timeout);
   void closeAll();
@@ -92,7 +94,7 @@ class SessionRegistry {
   ClosedSessionTotals closedTotals() const;
 
  private:
-  enum class CloseReason { kByClient, kIdle, kReclaimed, kShutdown };
+  enum class CloseReason { kByClient, kIdle, kReclaimed, kShutdown, kFailed };
   bool close(std::uint64_t session_id, CloseReason reason);
   // Adds a closed session to the totals and logs what it leaves undelivered.
   void account(const ServerSession& session, CloseReason reason);

@@ -71,6 +71,17 @@ void LocalSlam::afterFrame() {
     mapper_->processAll();
     if (loop_closer_) loop_closer_->processAll();
   }
+  // Tracking on without a back end would report poses from a map nobody maintains.
+  if (auto cause = failure()) throw std::runtime_error(*cause);
+}
+
+std::optional<std::string> LocalSlam::failure() const {
+  if (auto cause = mapper_->failure()) return cause;
+  if (loop_closer_) {
+    if (auto cause = loop_closer_->failure()) return cause;
+  }
+  if (segmentation_) return segmentation_->failure();
+  return std::nullopt;
 }
 
 void LocalSlam::finish() {

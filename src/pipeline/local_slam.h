@@ -23,6 +23,9 @@ class LocalSlam : public TrackingSlam {
   SlamCounters counters() const override;
   // nullptr without a vocabulary or with loop closing off.
   const LoopCloser* loopCloser() const { return loop_closer_.get(); }
+  // Why a back-end worker (mapping, loop closing, segmentation) ended with an exception; the
+  // next frame then throws it.
+  std::optional<std::string> failure() const;
   std::optional<MapIntrinsicsRefinement> intrinsicsRefinement() const override {
     return intrinsics_refinement_;
   }

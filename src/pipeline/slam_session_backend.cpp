@@ -228,6 +228,13 @@ std::optional<OffloadResult> SlamSessionBackend::onFrame(OffloadFrame frame) {
   return result;
 }
 
+std::optional<std::string> SlamSessionBackend::failure() const {
+  std::lock_guard view_lock(view_mutex_);
+  if (offload_) return offload_->failure();
+  if (mapping_) return mapping_->failure();
+  return std::nullopt;
+}
+
 MapSample SlamSessionBackend::mapSample(std::size_t max_points) const {
   std::lock_guard view_lock(view_mutex_);
   if (offload_) return offload_->mapSample(max_points);

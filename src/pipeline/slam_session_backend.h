@@ -8,6 +8,7 @@
 
 #include "edge/edge_map_session.h"
 #include "net/edge_server.h"
+#include "pipeline/local_slam.h"
 #include "pipeline/slam_system.h"
 #include "store/map_store_writer.h"
 
@@ -35,6 +36,7 @@ class SlamSessionBackend : public EdgeSessionBackend {
   // larger than a message.
   void onFullResyncRequested() override;
   std::uint64_t idFloor() const override { return id_floor_; }
+  std::optional<std::string> failure() const override;
 
   // For a viewer, from any thread: the session's map now (its global map in edge mode, the
   // offloaded SLAM's map in offload mode; empty before the first keyframe or frame) and the loops
@@ -57,7 +59,7 @@ class SlamSessionBackend : public EdgeSessionBackend {
   std::shared_ptr<Segmenter> segmenter_;          // when the session asked for semantic culling
   std::unique_ptr<MapStoreWriter> store_writer_;  // outlives mapping_, which it observes
   std::unique_ptr<EdgeMapSession> mapping_;       // edge mode, made at the first keyframe
-  std::unique_ptr<SlamSystem> offload_;           // offload mode, made at the first frame
+  std::unique_ptr<LocalSlam> offload_;            // offload mode, made at the first frame
   std::uint64_t id_floor_ = 0;
   std::atomic<std::uint64_t> slices_split_{0};     // slices sent as several parts
   std::atomic<std::uint64_t> slices_not_sent_{0};  // slices that could not be sent (logged)

@@ -134,6 +134,8 @@ std::vector<BadInvocation> sweep(const BadInputs& in) {
       {"run --dataset " + tum + " --frames ten", kUsage},
       {"run --dataset " + tum + " --frames 5-500", kUsage},  // past the dataset's 20 frames
       {"run --dataset " + tum + " --realtime --fast", kUsage},
+      {"run --dataset " + tum + " --deterministic --realtime", kUsage},
+      {"run --dataset " + tum + " --deterministic --mode edge", kUsage},
       {"run --dataset " + tum + " --format tiff", kUsage},
       {"run --dataset " + tum + " --sensor lidar", kUsage},
       {"run --dataset " + tum + " --link carrier-pigeon", kUsage},

@@ -1,17 +1,24 @@
 // Degenerate input that looks valid, as a user runs it: image folders made from real 7-Scenes
 // frames (a camera that does not move; a real walk with a blank stretch, a duplicated frame and a
-// frame from the past), through `edgeslam run`. No map may be built from the still camera, no
-// pose reported for a blank frame, and metrics.json must say why.
+// frame from the past; a walk that ends in a pure rotation) and KITTI 03 at highway speed, through
+// `edgeslam run`. No map may be built from the still camera, no pose reported for a blank frame,
+// no confident pose that is wrong, and metrics.json must say why.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
+#include <iostream>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
 
 #include "io/dataset.h"
 #include "io/temp_folder.h"
+#include "io/trajectory.h"
 #include "support/edgeslam_command.h"
 #include "support/image_folder_sequence.h"
 #include "support/shared_data.h"
@@ -22,6 +29,8 @@ namespace {
 
 namespace fs = std::filesystem;
 constexpr const char* kKitchen = "datasets/7scenes-redkitchen-1000";
+constexpr const char* kKitti03 = "datasets/kitti03-400";
+constexpr double kPi = 3.14159265358979323846;
 
 nlohmann::json run(const fs::path& dataset, const fs::path& out, const std::string& mode) {
   const auto r = test::runEdgeslam("run --dataset " + dataset.string() +
@@ -78,6 +87,144 @@ TEST(DegenerateRun, BlankStretchAndDisorderedFramesAreCountedNotTracked) {
   // the map are tracked.
   const int before_map = m["initialization"]["frames_without_map"].get<int>();
   EXPECT_GE(m["tracked"].get<int>(), 140 - 10 - before_map - 5) << m.dump(2);
+}
+
+// Every `stride`-th frame of a KITTI sequence as a sequence of its own (images linked, poses and
+// times renumbered): at stride 3 the car of KITTI 03 moves ~1.9 m a frame at 10 Hz (~68 km/h).
+void writeKittiAtStride(const fs::path& from, const fs::path& to, std::size_t stride,
+                        std::size_t count) {
+  fs::create_directories(to / "image_0");
+  fs::copy_file(from / "calib.txt", to / "calib.txt");
+  const std::vector<SE3d> poses = readKittiPoses(from / "poses.txt");
+  const std::vector<double> times = readTimes(from / "times.txt");
+  std::vector<SE3d> kept_poses;
+  std::ofstream kept_times(to / "times.txt");
+  kept_times << std::setprecision(12);
+  for (std::size_t i = 0; i < count && i * stride < poses.size(); ++i) {
+    char from_name[32];
+    char to_name[32];
+    std::snprintf(from_name, sizeof(from_name), "%06zu.jpg", i * stride);
+    std::snprintf(to_name, sizeof(to_name), "%06zu.jpg", i);
+    fs::create_symlink(from / "image_0" / from_name, to / "image_0" / to_name);
+    kept_poses.push_back(poses[i * stride]);
+    kept_times << times[i * stride] << "\n";
+  }
+  writeKittiPoses(to / "poses.txt", kept_poses);
+}
+
+double pathLength(const std::vector<SE3d>& poses) {
+  double length = 0.0;
+  for (std::size_t i = 1; i < poses.size(); ++i) {
+    length += (poses[i].translation() - poses[i - 1].translation()).norm();
+  }
+  return length;
+}
+
+// Forward motion at highway speed gives thin maps (little parallax ahead, large changes in
+// scale): the tracker may lose the road, but every pose it reports must be right, and what it
+// could not track must be counted, with its cause, and warned about.
+TEST(DegenerateRun, HighwaySpeedForwardMotionReportsOnlyPosesItCanTrust) {
+  EDGESLAM_REQUIRE_SHARED(kKitti03);
+  test::TempFolder folder;
+  const fs::path highway = folder / "highway";
+  writeKittiAtStride(test::sharedPath(kKitti03), highway, 3, 51);
+  const double path_m = pathLength(readKittiPoses(highway / "poses.txt"));
+  ASSERT_GT(path_m, 80.0);
+
+  const auto m = run(highway, folder / "out", "local");
+  ASSERT_FALSE(m.empty());
+  EXPECT_EQ(m["frames"], 51);
+  const int tracked = m["tracked"].get<int>();
+  const int lost = m["lost"].get<int>();
+  const int without_map = m["initialization"]["frames_without_map"].get<int>();
+  // Every frame is accounted for: tracked, lost, without a map, or tracked in a map that a reset
+  // discarded (its poses withdrawn).
+  EXPECT_GE(tracked + lost + without_map + m["tracked_in_discarded_maps"].get<int>(), 51)
+      << m.dump(2);
+  EXPECT_EQ(lost, m["lost_frames"]["too_few_features"].get<int>() +
+                      m["lost_frames"]["tracking_failed"].get<int>());
+  ASSERT_GE(tracked, 5) << "no map at all on a textured road";
+  // A confident wrong pose is the failure: every reported pose within 1 % of the drive.
+  // The poses evaluated are the tracked frames' and the map's first reference frame.
+  EXPECT_GE(m["ate"]["pairs"].get<int>(), tracked);
+  EXPECT_LE(m["ate"]["pairs"].get<int>(), tracked + 1);
+  EXPECT_LT(m["ate"]["rmse_m"].get<double>(), 0.01 * path_m) << m["ate"].dump();
+  std::cout << "highway: tracked " << tracked << " (+" << m["tracked_in_discarded_maps"]
+            << " in a discarded map), lost " << lost << ", without a map " << without_map
+            << ", ATE (sim3) " << m["ate"]["rmse_m"].get<double>() << " m over " << path_m
+            << " m\n";
+  if (lost > 0) {
+    bool warned = false;
+    for (const auto& warning : m["warnings"]) {
+      warned = warned || warning.get<std::string>().find("tracking lost") != std::string::npos;
+    }
+    EXPECT_TRUE(warned) << m["warnings"].dump();
+  }
+}
+
+// A camera that only rotates once the map exists gives no parallax for new points, but the map
+// it has fixes the rotation: the pan is tracked as a pan, frame by frame, and the camera centre
+// stays where it was (the ground truth of the panned frames is the last real pose turned by the
+// pan, exactly what the warp K R K^-1 shows).
+TEST(DegenerateRun, PureRotationAfterTheMapIsTrackedAsARotation) {
+  EDGESLAM_REQUIRE_SHARED(kKitchen);
+  test::TempFolder folder;
+  const fs::path walk = folder / "walk_then_pan";
+  auto reader = openDataset(test::sharedPath(kKitchen));
+  const Eigen::Matrix3d K = reader->camera().K();
+  constexpr std::size_t kWalk = 60;
+  constexpr std::size_t kPan = 30;
+  constexpr double kDegreesPerFrame = 0.5;
+  std::vector<test::StampedImage> frames;
+  Trajectory truth;
+  for (std::size_t i = 0; i < kWalk; ++i) {
+    const DatasetFrame frame = reader->load(i);
+    ASSERT_TRUE(frame.ground_truth.has_value());
+    frames.push_back({frame.gray, static_cast<double>(i) / 30.0});
+    truth.push_back({frames.back().timestamp, *frame.ground_truth});
+  }
+  const cv::Mat last = frames.back().image;
+  const SE3d last_pose = truth.back().pose;
+  for (std::size_t k = 1; k <= kPan; ++k) {
+    const Eigen::Matrix3d after_from_before =
+        panRotation(kDegreesPerFrame * static_cast<double>(k));
+    const double t = static_cast<double>(kWalk - 1 + k) / 30.0;
+    frames.push_back({rotatedView(last, K, after_from_before), t});
+    truth.push_back({t, last_pose * SE3d(Eigen::Matrix3d(after_from_before.transpose()),
+                                         Eigen::Vector3d::Zero())});
+  }
+  test::writeImageFolder(walk, frames);
+  writeTumTrajectory(walk / "groundtruth.txt", truth);
+
+  const auto m = run(walk, folder / "out", "local");
+  ASSERT_FALSE(m.empty());
+  ASSERT_EQ(m["initialization"]["map_built"], true) << m.dump(2);
+  const Trajectory estimate = readTumTrajectory(folder / "out" / "trajectory.tum");
+  const double last_walk_time = static_cast<double>(kWalk - 1) / 30.0;
+  const StampedPose* before_pan = nullptr;
+  for (const StampedPose& pose : estimate) {
+    if (std::abs(pose.timestamp - last_walk_time) < 1e-6) before_pan = &pose;
+  }
+  ASSERT_NE(before_pan, nullptr) << "the last frame before the pan was not tracked";
+  std::size_t panned_tracked = 0;
+  double worst_turn_error_deg = 0.0;
+  for (const StampedPose& pose : estimate) {
+    if (pose.timestamp < last_walk_time + 1e-6) continue;
+    ++panned_tracked;
+    const double k = std::round((pose.timestamp - last_walk_time) * 30.0);
+    const double turned_deg = rotationDistance(pose.pose, before_pan->pose) * 180.0 / kPi;
+    EXPECT_NEAR(turned_deg, kDegreesPerFrame * k, 0.5) << "panned frame " << k;
+    worst_turn_error_deg =
+        std::max(worst_turn_error_deg, std::abs(turned_deg - kDegreesPerFrame * k));
+  }
+  std::cout << "pan: " << panned_tracked << " of " << kPan
+            << " panned frames tracked, worst turn error " << worst_turn_error_deg
+            << " deg, ATE (sim3) " << m["ate"]["rmse_m"].get<double>() * 100.0 << " cm, keyframes "
+            << m["keyframes"] << ", points " << m["map_points"] << "\n";
+  EXPECT_GE(panned_tracked, kPan - 2) << m.dump(2);
+  // The camera centre must not wander during the pan: the whole run, walk and pan, stays within
+  // the walk's accuracy (sim3: monocular scale).
+  EXPECT_LT(m["ate"]["rmse_m"].get<double>(), 0.05) << m["ate"].dump();
 }
 
 }  // namespace

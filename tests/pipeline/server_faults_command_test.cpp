@@ -7,6 +7,7 @@
 #include <sys/socket.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -314,6 +315,68 @@ TEST_F(ServerFaults, DuplicatedAndOutOfOrderFramesAreSkippedAndCounted) {
   EXPECT_EQ(server["closed_sessions"]["missing_uploads"], 0) << server.dump(2);
   EXPECT_EQ(server["closed_sessions"]["duplicate_uploads"], 0) << server.dump(2);
   expectServerStopsCleanly();
+}
+
+// A back-end worker that throws (a fault injected into local mapping: the 12th keyframe the
+// server maps, in whichever session that is) ends that session alone. Its client is told why
+// (ABORTED with the cause), opens a new session and carries on; the other client and the server
+// are unaffected; the server logs and counts the failed session.
+TEST_F(ServerFaults, FailingSessionWorkerEndsThatSessionAloneWithItsCause) {
+  const std::string faulty_address = "127.0.0.1:" + std::to_string(freePort());
+  ::setenv("EDGESLAM_FAILPOINTS", "local_mapping@12", 1);
+  test::ChildProcess faulty(
+      test::edgeslamBinary(),
+      std::vector<std::string>{"server", "--listen", faulty_address, "--status-every", "1",
+                               "--idle-timeout", "3", "--metrics",
+                               (folder_ / "faulty.json").string(), "--maps", "none", "--vocab",
+                               "none", "--semantic", "off"},
+      folder_ / "faulty.log");
+  ::unsetenv("EDGESLAM_FAILPOINTS");
+  ASSERT_TRUE(faulty.waitForLog("listening", 20s)) << faulty.log();
+  auto first = startClient("first", 150, "", faulty_address);
+  auto second = startClient("second", 150, "", faulty_address);
+
+  int told = 0;
+  for (auto* client : {first.get(), second.get()}) {
+    const auto code = client->wait(240s);
+    ASSERT_TRUE(code.has_value()) << "a client hung\n" << client->log();
+    EXPECT_EQ(*code, 0) << client->log();
+    told += client->log().find("ended on the edge: local mapping failed: fault injected") !=
+                    std::string::npos
+                ? 1
+                : 0;
+  }
+  EXPECT_EQ(told, 1) << first->log() << second->log();
+  // Both tracked on; the client whose session ended went on in a new one.
+  for (const char* name : {"first", "second"}) {
+    const auto m = readJson(folder_ / name / "metrics.json");
+    ASSERT_FALSE(m.empty());
+    printClient(name, m);
+    EXPECT_EQ(m["tracked"], 150) << name;
+    EXPECT_LT(m["ate"]["rmse_m"].get<double>(), 0.08) << name;
+  }
+  ASSERT_TRUE(faulty.running()) << faulty.log();
+  EXPECT_NE(faulty.log().find("local mapping failed: fault injected at local_mapping"),
+            std::string::npos)
+      << faulty.log();
+  EXPECT_NE(faulty.log().find("closed after its back end failed"), std::string::npos)
+      << faulty.log();
+  const auto m = [&] {
+    const auto until = std::chrono::steady_clock::now() + 10s;
+    nlohmann::json j;
+    while (std::chrono::steady_clock::now() < until) {
+      j = readJson(folder_ / "faulty.json");
+      if (!j.empty() && j["closed_sessions"]["sessions"].get<int>() >= 3) break;
+      std::this_thread::sleep_for(200ms);
+    }
+    return j;
+  }();
+  EXPECT_EQ(m["closed_sessions"]["failed"], 1) << m.dump(2);
+  std::cout << "faulty server: " << m["closed_sessions"].dump() << "\n";
+  faulty.signal(SIGTERM);
+  const auto code = faulty.wait(10s);
+  ASSERT_TRUE(code.has_value()) << faulty.log();
+  EXPECT_EQ(*code, 0) << faulty.log();
 }
 
 }  // namespace
