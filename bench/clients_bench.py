@@ -3,8 +3,9 @@
 
 For each sensor and client count, one `edgeslam server` (a real map store in a temporary folder)
 and N `edgeslam client` processes in edge mode, fed at the camera's rate (--realtime, so a client
-that falls behind drops frames and counts them). Each client slot plays the dataset --passes times
-in a row as new sessions, so the server carries the load for minutes and sees sessions come and go.
+that falls behind takes the newest due frame and counts the ones it skipped). Each client slot
+plays the dataset --passes times in a row as new sessions, so the server carries the load for
+minutes and sees sessions come and go.
 The server's RSS and CPU are sampled from /proc every --sample-s seconds.
 
 Writes the table to docs/benchmarks.md (between the CLIENTS markers) unless --no-docs, and
@@ -114,22 +115,30 @@ def summarize(sensor, clients, runs, samples, elapsed, server_log):
     e2e_p50 = [m["e2e_ms"]["median"] for m in metrics]
     frames = sum(m["frames"] for m in metrics)
     tracked = sum(m["tracked"] for m in metrics)
-    dropped = sum(m.get("frames_dropped_late", 0) for m in metrics)
+    skipped = sum(m.get("frames_skipped_late", m.get("frames_dropped_late", 0)) for m in metrics)
+    processed = sum(m.get("frames_processed", m["frames"]) for m in metrics)
+    lost = sum(m["lost"] for m in metrics)
+    relocalizations = sum(m.get("relocalizations", 0) for m in metrics)
     uploads_lost = sum(m.get("uploads_dropped", 0) + m.get("uploads_overflowed", 0)
                        for m in metrics)
     ates = [m["ate"]["rmse_m"] for m in metrics if "ate" in m]
+    client_p95 = [m["client_ms"]["p95"] for m in metrics]
+    read_p95 = [m["load_ms"]["p95"] for m in metrics if "load_ms" in m]
     cpu = [c for _, c, _ in samples]
     rss = [r for _, _, r in samples]
     with open(server_log) as f:
         server_errors = sum(1 for line in f if "[error]" in line or "[critical]" in line)
     return {
         "sensor": sensor, "clients": clients, "sessions": len(runs), "failures": failures,
-        "elapsed_s": elapsed, "frames": frames, "tracked": tracked, "dropped_late": dropped,
+        "elapsed_s": elapsed, "frames": frames, "tracked": tracked, "skipped_late": skipped,
+        "processed": processed, "lost": lost, "relocalizations": relocalizations,
         "uploads_lost": uploads_lost, "server_errors": server_errors,
         "e2e_p50_median": statistics.median(e2e_p50) if e2e_p50 else None,
         "e2e_p95_median": statistics.median(e2e_p95) if e2e_p95 else None,
         "e2e_p95_worst": max(e2e_p95) if e2e_p95 else None,
         "ate_cm_median": 100 * statistics.median(ates) if ates else None,
+        "client_p95_median": statistics.median(client_p95) if client_p95 else None,
+        "read_p95_median": statistics.median(read_p95) if read_p95 else None,
         "cpu_mean": statistics.mean(cpu) if cpu else None,
         "cpu_p95": sorted(cpu)[int(0.95 * (len(cpu) - 1))] if cpu else None,
         "rss_first": rss[0] if rss else None, "rss_max": max(rss) if rss else None,
@@ -146,19 +155,26 @@ def table(results, args):
         f"{args.frames} frames of {os.path.basename(args.dataset)} per session at the camera's "
         f"rate, {args.passes} sessions in a row per client slot, edge mode, one server with a map "
         "store, all on this 2-core machine. e2e = frame arrival to pose (ms), the median over "
-        "sessions of each session's p50 / p95, and the worst session's p95. Frames dropped late: "
-        "the client fell behind the camera and skipped them (counted in its metrics.json).",
+        "sessions of each session's p50 / p95, and the worst session's p95. Skipped late: frames "
+        "the camera produced while the client was busy, never read (the client takes the newest "
+        "due frame; `frames_skipped_late` in its metrics.json). Tracked and lost: of the frames "
+        "processed. Relocs: relocalisations over all sessions. Client and read ms: the median over "
+        "sessions of each session's p95 of tracking a frame and of reading (decoding) it.",
         "",
-        "| sensor | clients | sessions | frames tracked | dropped late | uploads lost | "
-        "e2e p50 / p95 (worst p95) ms | ATE cm (median) | server CPU % mean / p95 | "
-        "server RSS MiB first / max / last | failures |",
-        "|---|---|---|---|---|---|---|---|---|---|---|"]
+        "| sensor | clients | sessions | frames | skipped late | processed | tracked | lost | "
+        "relocs | uploads lost | e2e p50 / p95 (worst p95) ms | client / read ms p95 | "
+        "ATE cm (median) | "
+        "server CPU % mean / p95 | server RSS MiB first / max / last | failures |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in results:
-        tracked = f"{r['tracked']}/{r['frames']} ({100 * r['tracked'] / max(r['frames'], 1):.1f} %)"
+        share = lambda n, whole: f"{n} ({100 * n / max(whole, 1):.1f} %)"
         lines.append(
-            f"| {r['sensor']} | {r['clients']} | {r['sessions']} | {tracked} | {r['dropped_late']} | "
+            f"| {r['sensor']} | {r['clients']} | {r['sessions']} | {r['frames']} | "
+            f"{share(r['skipped_late'], r['frames'])} | {r['processed']} | "
+            f"{share(r['tracked'], r['processed'])} | {r['lost']} | {r['relocalizations']} | "
             f"{r['uploads_lost']} | {fmt(r['e2e_p50_median'])} / {fmt(r['e2e_p95_median'])} "
-            f"({fmt(r['e2e_p95_worst'])}) | {fmt(r['ate_cm_median'], 2)} | "
+            f"({fmt(r['e2e_p95_worst'])}) | {fmt(r['client_p95_median'])} / "
+            f"{fmt(r['read_p95_median'])} | {fmt(r['ate_cm_median'], 2)} | "
             f"{fmt(r['cpu_mean'], 0)} / {fmt(r['cpu_p95'], 0)} | {fmt(r['rss_first'], 0)} / "
             f"{fmt(r['rss_max'], 0)} / {fmt(r['rss_last'], 0)} | "
             f"{len(r['failures']) + r['server_errors'] or 'none'} |")

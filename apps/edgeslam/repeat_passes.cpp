@@ -44,6 +44,7 @@ PassRecord& PassLog::current(std::size_t index, double timestamp) {
 
 void PassLog::addFrame(std::size_t index, double timestamp, const TrackResult& result) {
   PassRecord& pass = current(index, timestamp);
+  pass.last_frame = index;
   pass.last_timestamp = timestamp;
   ++pass.frames;
   if (result.state == TrackingState::kOk) ++pass.tracked;
@@ -52,13 +53,22 @@ void PassLog::addFrame(std::size_t index, double timestamp, const TrackResult& r
   if (result.new_keyframe) ++pass.keyframes_made;
 }
 
-void PassLog::afterFrame(std::size_t index, bool last_of_run, const SlamSystem& slam,
-                         const std::function<std::optional<EdgeMapSize>()>& edge_map,
-                         double wall_s) {
-  if (!open_) return;  // every frame of the pass so far was skipped
-  if (!last_of_run && (frames_per_pass_ == 0 || (index + 1) % frames_per_pass_ != 0)) return;
+void PassLog::beforeFrame(std::size_t index, const SlamSystem& slam,
+                          const std::function<std::optional<EdgeMapSize>()>& edge_map,
+                          double wall_s) {
+  if (!open_ || frames_per_pass_ == 0) return;
+  if (index / frames_per_pass_ == passes_.back().first_frame / frames_per_pass_) return;
+  close(slam, edge_map, wall_s);
+}
+
+void PassLog::finish(const SlamSystem& slam,
+                     const std::function<std::optional<EdgeMapSize>()>& edge_map, double wall_s) {
+  if (open_) close(slam, edge_map, wall_s);
+}
+
+void PassLog::close(const SlamSystem& slam,
+                    const std::function<std::optional<EdgeMapSize>()>& edge_map, double wall_s) {
   PassRecord& pass = passes_.back();
-  pass.last_frame = index;
   const std::optional<EdgeMapSize> edge = edge_map ? edge_map() : std::nullopt;
   pass.map_keyframes = edge ? edge->keyframes : slam.keyFrameCount();
   pass.map_points = edge ? edge->points : slam.mapPointCount();

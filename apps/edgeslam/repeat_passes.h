@@ -48,11 +48,14 @@ class PassLog {
   explicit PassLog(std::size_t frames_per_pass) : frames_per_pass_(frames_per_pass) {}
 
   void addFrame(std::size_t index, double timestamp, const TrackResult& result);
-  // Call after each frame: closes the pass when `index` is its last frame (or the run's). The map's
-  // size is what `edge_map` says when it says something (asked at pass ends only), else the
-  // SlamSystem's.
-  void afterFrame(std::size_t index, bool last_of_run, const SlamSystem& slam,
-                  const std::function<std::optional<EdgeMapSize>()>& edge_map, double wall_s);
+  // Call before each frame (frames skipped late are never seen, so a pass may end on any frame):
+  // closes the open pass when frame `index` belongs to a later one. finish() closes the last.
+  // The map's size is what `edge_map` says when it says something (asked at pass ends only),
+  // else the SlamSystem's.
+  void beforeFrame(std::size_t index, const SlamSystem& slam,
+                   const std::function<std::optional<EdgeMapSize>()>& edge_map, double wall_s);
+  void finish(const SlamSystem& slam, const std::function<std::optional<EdgeMapSize>()>& edge_map,
+              double wall_s);
 
   const std::vector<PassRecord>& passes() const { return passes_; }
   // One entry per pass, with its ATE (own alignment, and within the whole run's alignment, which
@@ -64,6 +67,8 @@ class PassLog {
 
  private:
   PassRecord& current(std::size_t index, double timestamp);
+  void close(const SlamSystem& slam, const std::function<std::optional<EdgeMapSize>()>& edge_map,
+             double wall_s);
 
   std::size_t frames_per_pass_;
   std::vector<PassRecord> passes_;

@@ -17,8 +17,8 @@
 #include "io/camera_file.h"
 #include "io/dataset.h"
 #include "io/frame_order_guard.h"
-#include "io/frame_prefetcher.h"
 #include "io/frame_range.h"
+#include "io/live_camera.h"
 #include "io/repeated_dataset.h"
 #include "io/trajectory.h"
 #include "link/link_settings.h"
@@ -86,6 +86,16 @@ std::optional<nlohmann::json> ateJson(const Trajectory& gt, const Trajectory& es
                         {"pairs", ate.translation.count},
                         {"scale", ate.alignment.scale()},
                         {"align", toString(align)}};
+}
+
+// Test hook (tests/pipeline/live_camera_command_test.cpp): EDGESLAM_TEST_EXTRA_LOAD_MS makes each
+// paced frame read that much slower, a device too slow for its camera.
+double testExtraLoadMs() {
+  const char* value = std::getenv("EDGESLAM_TEST_EXTRA_LOAD_MS");
+  if (value == nullptr) return 0.0;
+  char* end = nullptr;
+  const double ms = std::strtod(value, &end);
+  return end != value && ms > 0.0 ? ms : 0.0;
 }
 
 Sensor toSensor(const std::string& name) {
@@ -327,61 +337,56 @@ int runPipeline(const RunOptions& given) {
   viz::RunStatus view_status{
       .frames_total = frame_count, .mode = mode, .sensor = sensor_name, .link = options.link};
   // e2e: from the frame's arrival to its pose. With --realtime a frame arrives at its due time
-  // (so a client that falls behind makes later frames wait); otherwise when it has been read.
+  // on the camera clock (so reading it and any backlog count); otherwise when it has been read.
   SampleStats client_ms, load_ms, e2e_ms;
   std::vector<FrameLogEntry> frame_log;
   frame_log.reserve(frame_count);
   ProgressLine progress;
   Stopwatch wall;
   Trajectory ground_truth;
-  std::size_t tracked = 0, lost = 0, frames_dropped_late = 0;
+  std::size_t tracked = 0, lost = 0;
   std::size_t tracked_in_discarded_maps = 0, resets_seen = 0;
   FrameOrderGuard frame_order;
   std::optional<SemanticEvaluation> semantic_eval = SemanticEvaluation::open(info.path);
   if (semantic_eval) spdlog::info("ground-truth masks found: scoring the semantic culling");
-  const auto& stamps = reader->timestamps();
-  // Paced runs read ahead on a thread of their own, and a frame waits for its time after it is
-  // decoded: a camera hands over decoded frames at their timestamps, so reading the dataset's
-  // files is not the tracker's latency (load_ms reports it; it still counts when reading makes a
-  // frame late). Unpaced runs read each frame when they come to it.
-  std::optional<FramePrefetcher> prefetcher;
+  // Paced runs play the dataset as a live camera: a client that falls behind takes the newest
+  // frame due and skips (never reads) the ones it was too busy for, so its latency stays bounded
+  // under CPU starvation instead of growing with a queue of stale frames.
+  std::optional<LiveCamera> live_camera;
   if (options.realtime) {
-    prefetcher.emplace(
-        *reader, frame_count,
-        FramePrefetcherOptions{.frames_ahead = 4, .thread_nice = slam_options.background_nice});
+    live_camera.emplace(*reader, frame_count,
+                        LiveCameraClock{.now_ms = [&wall] { return wall.elapsedMs(); },
+                                        .sleep_ms = steadyLiveCameraClock().sleep_ms},
+                        LiveCameraOptions{.extra_load_ms = testExtraLoadMs()});
   }
   const auto edge_map_size = [&edge] { return edge.sessionMapSize(); };
   std::optional<PassLog> pass_log;
   if (options.repeat > 1) pass_log.emplace(frames_per_pass);
-  for (std::size_t i = 0; i < frame_count; ++i) {
-    if (pass_log && i > 0) {
-      pass_log->afterFrame(i - 1, false, slam, edge_map_size, wall.elapsedMs() / 1000.0);
+  std::size_t next_unpaced = 0;
+  for (;;) {
+    std::size_t i = 0;
+    DatasetFrame frame;
+    double due_ms = 0.0;
+    if (live_camera) {
+      std::optional<LiveFrame> live = live_camera->grab();
+      if (!live) break;
+      i = live->index;
+      due_ms = live->due_ms;
+      load_ms.add(live->load_ms);
+      frame = std::move(live->frame);
+    } else {
+      if (next_unpaced >= frame_count) break;
+      i = next_unpaced++;
+      Stopwatch load_timer;
+      frame = reader->load(i);
+      load_ms.add(load_timer.elapsedMs());
     }
-    Stopwatch load_timer;
-    const PrefetchedFrame prefetched =
-        prefetcher ? prefetcher->next() : PrefetchedFrame{reader->load(i), 0.0};
-    const DatasetFrame& frame = prefetched.frame;
-    load_ms.add(prefetcher ? prefetched.load_ms : load_timer.elapsedMs());
-    if (options.realtime && i > 0) {
-      const double due_ms = (stamps[i] - stamps[0]) * 1000.0;
-      const double wait_ms = due_ms - wall.elapsedMs();
-      if (wait_ms > 0)
-        std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(wait_ms));
-    }
+    if (pass_log) pass_log->beforeFrame(i, slam, edge_map_size, wall.elapsedMs() / 1000.0);
     if (const auto rejection = frame_order.check(frame.timestamp)) {
       spdlog::warn("frame {} skipped: {} (t = {:.6f} s)", i, toString(*rejection), frame.timestamp);
       continue;
     }
     if (frame.ground_truth) ground_truth.push_back({frame.timestamp, *frame.ground_truth});
-    // Like a camera driver that keeps the newest frame: once the next frame is due and delivered,
-    // this one is stale and dropped, so a client slower than the camera skips frames instead of
-    // lagging more. A frame the reader has not delivered yet is no newer frame (a starved reading
-    // thread is the host's lateness, not the client's).
-    if (options.realtime && i + 1 < frame_count &&
-        wall.elapsedMs() > (stamps[i + 1] - stamps[0]) * 1000.0 && prefetcher->nextIsReady()) {
-      ++frames_dropped_late;
-      continue;
-    }
     Stopwatch frame_timer;
     const TrackResult result =
         slam.process(i, frame.timestamp, frame.gray, frame.depth, frame.color);
@@ -391,10 +396,7 @@ int runPipeline(const RunOptions& given) {
     if (pass_log) pass_log->addFrame(i, frame.timestamp, result);
     client_ms.add(processing_ms);
     double frame_e2e_ms = processing_ms;
-    if (options.realtime) {
-      const double due_ms = (stamps[i] - stamps[0]) * 1000.0;
-      frame_e2e_ms = std::max(processing_ms, wall.elapsedMs() - due_ms);
-    }
+    if (live_camera) frame_e2e_ms = std::max(processing_ms, wall.elapsedMs() - due_ms);
     e2e_ms.add(frame_e2e_ms);
     const ClientStageTimes stages = slam.lastFrameStages();
     frame_log.push_back({i, frame.timestamp, result.state, result.new_keyframe, result.relocalized,
@@ -451,10 +453,13 @@ int runPipeline(const RunOptions& given) {
     }
   }
   progress.finish();
-  if (pass_log && frame_count > 0) {
-    pass_log->afterFrame(frame_count - 1, true, slam, edge_map_size, wall.elapsedMs() / 1000.0);
+  if (pass_log) {
+    pass_log->finish(slam, edge_map_size, wall.elapsedMs() / 1000.0);
   }
   slam.finish();
+  // A live camera's skipped frames (kept under the older name too, which counted late drops).
+  const std::size_t frames_skipped_late = live_camera ? live_camera->skipped() : 0;
+  const std::size_t frames_dropped_late = frames_skipped_late;
   // What the edge's map store holds now (the last changes written first).
   const nlohmann::json store_metrics = storeMetrics(edge.store, options.map_name);
   const double seconds = wall.elapsedMs() / 1000.0;
@@ -523,6 +528,10 @@ int runPipeline(const RunOptions& given) {
                             {"pacing", options.realtime ? "realtime" : "fast"},
                             {"deterministic", options.deterministic},
                             {"frames_dropped_late", frames_dropped_late},
+                            {"frames_skipped_late", frames_skipped_late},
+                            {"frames_processed", frame_log.size()},
+                            {"frames_read", live_camera ? live_camera->reads() : frame_count},
+                            {"frames_read_unused", live_camera ? live_camera->unusedReads() : 0},
                             {"frames_out_of_order",
                              {{"skipped", frame_order.rejected()},
                               {"duplicate_timestamp", frame_order.duplicates()},
@@ -695,7 +704,7 @@ int runPipeline(const RunOptions& given) {
   if (counters.backend.waits > 0 || frames_dropped_late > 0) {
     fmt::print(
         "  pacing       {}: waited for the back end {} times, {:.1f} s in all; {} frames "
-        "dropped late\n",
+        "skipped late (the camera had a newer one)\n",
         options.realtime ? "realtime" : "fast", counters.backend.waits,
         counters.backend.wait_total_ms / 1000.0, frames_dropped_late);
   }

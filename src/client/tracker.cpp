@@ -12,6 +12,20 @@
 #include "optimize/map_optimization.h"
 
 namespace edgeslam {
+namespace {
+
+// Frames from the last tracked one to `frame_index` (1 when there is none to count from).
+std::size_t framesSince(const std::optional<Frame>& last, std::size_t frame_index) {
+  return last && last->index < frame_index ? frame_index - last->index : 1;
+}
+
+// The constant per-frame motion that makes up `motion` over `frames` frames.
+SE3d perFrameMotion(const SE3d& motion, std::size_t frames) {
+  if (frames <= 1) return motion;
+  return SE3d::exp(motion.log() / static_cast<double>(frames));
+}
+
+}  // namespace
 
 const char* toString(TrackingState state) {
   switch (state) {
@@ -99,7 +113,8 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
       }
     }
     if (state_ == TrackingState::kOk) {
-      ok = velocity_ && trackWithMotionModel(frame);
+      // Frames skipped by a live camera (a client behind it) leave gaps: the prediction spans them.
+      ok = velocity_ && trackWithMotionModel(frame, framesSince(last_frame_, frame_index));
       if (!ok) ok = trackReferenceKeyFrame(frame);
     } else {
       if (canRecoverByPrediction(frame_index) &&
@@ -137,10 +152,13 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
       }
       if (state_ != TrackingState::kOk) frames_lost_ = 0;
       state_ = TrackingState::kOk;
-      // After a gap the difference to the last tracked frame spans several frames: the velocity
-      // that bridged it stays.
-      if (last_frame_ && last_frame_->T_cw && last_frame_->index + 1 == frame_index) {
-        velocity_ = *frame.T_cw * last_frame_->T_cw->inverse();
+      // The velocity is per frame: over a gap (frames skipped or lost) the motion since the last
+      // tracked frame is spread evenly over it, so the next prediction spans its own gap. Not
+      // after a relocalisation: the camera may have gone anywhere since the last tracked frame.
+      if (!result.relocalized && last_frame_ && last_frame_->T_cw &&
+          last_frame_->index < frame_index) {
+        velocity_ = perFrameMotion(*frame.T_cw * last_frame_->T_cw->inverse(),
+                                   frame_index - last_frame_->index);
       }
       const KeyFrameDecision decision = decide(frame, inliers);
       if (isKeyFrame(decision)) {

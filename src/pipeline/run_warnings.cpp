@@ -11,7 +11,8 @@ std::vector<std::string> runWarnings(const RunHealth& h, const RunWarningThresho
   const auto fraction = [](double part, double whole) { return whole > 0.0 ? part / whole : 0.0; };
   if (h.frames_dropped_late > 0) {
     out.push_back(fmt::format(
-        "{} of {} frames dropped: the client fell behind the camera (--fast waits instead)",
+        "{} of {} frames skipped late: the client fell behind the camera and took the newest "
+        "frame (--fast waits instead)",
         h.frames_dropped_late, h.frames));
   }
   const std::size_t processed =

@@ -16,7 +16,7 @@ TEST(RunWarnings, NameWhatMadeTheRunWorse) {
   health.keyframe_depth_ratio = 0.3;
   const auto warnings = runWarnings(health);
   ASSERT_EQ(warnings.size(), 5u);
-  EXPECT_NE(warnings[0].find("10 of 400 frames dropped"), std::string::npos) << warnings[0];
+  EXPECT_NE(warnings[0].find("10 of 400 frames skipped late"), std::string::npos) << warnings[0];
   EXPECT_NE(warnings[1].find("lost on 50 of 390"), std::string::npos) << warnings[1];
   EXPECT_NE(warnings[2].find("backlog"), std::string::npos) << warnings[2];
   EXPECT_NE(warnings[3].find("waited 30.0 s"), std::string::npos) << warnings[3];
