@@ -8,6 +8,7 @@ set -uo pipefail
 FUZZ_DIR=${FUZZ_DIR:-build-asan}
 FUZZ_SECONDS=${FUZZ_SECONDS:-20}
 FUZZ_RUNS=${FUZZ_RUNS:--1}
+FUZZ_HARNESSES=${FUZZ_HARNESSES:-}  # names (fuzz_camera_yaml ...) to run only these
 SHARED=${EDGESLAM_SHARED:-$(cd "$(dirname "$0")/../.." && pwd)/shared}
 seeds="$FUZZ_DIR/fuzz-seeds"
 rm -rf "$seeds"
@@ -18,6 +19,7 @@ printf '%-24s %12s %10s %s\n' harness executions exec/s result
 for harness in "$FUZZ_DIR"/tests/fuzz/fuzz_*; do
   name=$(basename "$harness")
   [ "$name" = fuzz_seeds ] && continue
+  if [ -n "$FUZZ_HARNESSES" ] && [[ " $FUZZ_HARNESSES " != *" $name "* ]]; then continue; fi
   [ -x "$harness" ] || continue
   corpus="$FUZZ_DIR/fuzz-corpus/$name"
   mkdir -p "$corpus" "$seeds/$name"
