@@ -591,11 +591,13 @@ int runPipeline(const RunOptions& given) {
                              {"max_points", c.max_points},
                              {"keyframes_evicted", c.keyframes_evicted},
                              {"keyframes_entered", c.keyframes_entered}};
-    // Every keyframe the client made is on the edge, on its way, or lost for a reason below.
+    // Every keyframe the client made is on the edge, culled there as redundant, on its way, or
+    // lost for a reason below.
     const ResyncCounters r = edge_slam->resyncCounters();
     metrics["resync"] = {{"full_resyncs", r.full_resyncs},
                          {"keyframes_made", counters.keyframes_uploaded - r.keyframes_resent},
                          {"keyframes_resent", r.keyframes_resent},
+                         {"keyframes_culled_by_edge", r.keyframes_culled_by_edge},
                          {"keyframes_lost",
                           {{"upload_dropped", counters.keyframes_forgotten},
                            {"evicted_before_stored", r.keyframes_lost_evicted}}}};

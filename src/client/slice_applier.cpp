@@ -80,7 +80,10 @@ SliceApplyResult applySlice(Map& map, const MapSlice& slice, const PinholeCamera
   for (KeyFrameId id : slice.keyframes_erased) {
     if (KeyFrame* kf = map.keyFrame(id)) {
       map.eraseKeyFrame(kf);
-      if (kf->isBad()) ++result.keyframes_erased;
+      if (kf->isBad()) {
+        ++result.keyframes_erased;
+        result.erased_keyframe_ids.push_back(id);
+      }
     }
   }
   std::optional<std::pair<SE3d, SE3d>> anchor_move;  // the processed keyframe's before, after

@@ -24,6 +24,7 @@ struct SliceApplyResult {
   std::size_t points_erased = 0;
   std::size_t keyframes_moved = 0;
   std::size_t keyframes_erased = 0;
+  std::vector<KeyFrameId> erased_keyframe_ids;  // the slice's erasures the client applied
   // Keyframes newer than the slice's that followed its keyframe's correction.
   std::size_t keyframes_carried = 0;
   std::size_t frame_index = 0;  // of the processed keyframe, 0 when the client does not have it

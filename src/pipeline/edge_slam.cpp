@@ -20,6 +20,8 @@ EdgeSlam::EdgeSlam(const PinholeCamera& camera, SlamOptions options, std::unique
   sink_options.camera = camera_;
   // The edge resumed a stored map holding ids of this origin: ours start above them.
   if (link_->idFloor() != 0) map_.ids().advancePast(link_->idFloor());
+  own_id_origin_ = link_->idOrigin();
+  own_ids_above_ = link_->idFloor();
   sink_ = std::make_unique<EdgeKeyFrameSink>(map_, *link_, sink_options);
   link_->setSliceHandler([this](MapSlice slice) { onSlice(std::move(slice)); });
   link_->setUploadDroppedHandler(
@@ -188,6 +190,9 @@ void EdgeSlam::onSlice(MapSlice slice) {
   if (slice.map_keyframes > 0 || slice.map_points > 0) {
     edge_map_keyframes_ = slice.map_keyframes;
     edge_map_points_ = slice.map_points;
+  }
+  for (const KeyFrameId id : applied.erased_keyframe_ids) {
+    if ((id >> 56) == own_id_origin_ && id > own_ids_above_) ++resync_.keyframes_culled_by_edge;
   }
   client_map_.keyframes_evicted += applied.keyframes_evicted.size();
   client_map_.keyframes_entered += applied.keyframes_entered.size();

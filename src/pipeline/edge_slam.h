@@ -32,6 +32,9 @@ struct ResyncCounters {
   // The edge lacked them and the client no longer had their features (evicted from its bounded
   // map before the edge stored them): lost.
   std::uint64_t keyframes_lost_evicted = 0;
+  // This client's keyframes the edge erased (culled as redundant, on a revisit say): neither in
+  // the edge map nor lost.
+  std::uint64_t keyframes_culled_by_edge = 0;
 };
 
 class EdgeSlam : public TrackingSlam {
@@ -94,6 +97,9 @@ class EdgeSlam : public TrackingSlam {
   // Keyframes a full resync found missing on the edge, re-sent on the tracking thread.
   std::vector<KeyFrameId> keyframes_to_resend_;
   ResyncCounters resync_;
+  // This client's keyframe ids: of the link's origin, above what the edge held when it opened.
+  std::uint8_t own_id_origin_ = 0;
+  KeyFrameId own_ids_above_ = 0;
 };
 
 }  // namespace edgeslam

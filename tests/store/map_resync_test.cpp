@@ -136,18 +136,22 @@ TEST(MapResync, ServerKilledAndRestartedOnItsStoreLosesNoKeyframe) {
     return metrics["tracked"].get<double>() / metrics["frames_processed"].get<double>();
   };
   EXPECT_GE(tracked_share(m), 0.95 * tracked_share(calm.metrics));
-  // Every keyframe the client made is in the stored edge map or counted as lost with a reason
-  // (the edge's own culling may take a few).
+  // Every keyframe the client made is in the stored edge map, culled there as redundant (a
+  // revisit), or counted as lost with a reason.
   ASSERT_TRUE(m["resync"]["keyframes_lost"].is_object());
   int lost = 0;
   for (const auto& [reason, count] : m["resync"]["keyframes_lost"].items())
     lost += count.get<int>();
   const double made = m["resync"]["keyframes_made"].get<double>();
-  EXPECT_GE(killed.map_info["keyframes"].get<double>() + lost, 0.95 * made) << m["resync"].dump();
-  // And about as many as an undisturbed run holds: measured 89-102 against 91 on a quiet host;
-  // the margin is for the keyframe decisions' run-to-run spread on a busy one.
+  const double culled = m["resync"]["keyframes_culled_by_edge"].get<double>();
+  EXPECT_GE(killed.map_info["keyframes"].get<double>() + culled + lost, 0.97 * made)
+      << m["resync"].dump();
+  // And not far from what an undisturbed run holds. The two runs decide their keyframes apart
+  // (the live camera skips other frames; a resynchronised client tracks a denser map and makes
+  // fewer): 70-108 measured against 88-99 undisturbed. The bug, the keyframes before the
+  // outage lost, left about 40 %.
   const double calm_keyframes = calm.map_info["keyframes"].get<double>();
-  EXPECT_GE(killed.map_info["keyframes"].get<double>(), 0.85 * calm_keyframes);
+  EXPECT_GE(killed.map_info["keyframes"].get<double>(), 0.6 * calm_keyframes);
   // Keyframe accuracy: within 10 % of the undisturbed run's, or 1 cm (run-to-run spread).
   ASSERT_GT(calm.keyframe_ate_m, 0.0);
   ASSERT_GT(killed.keyframe_ate_m, 0.0);
