@@ -7,6 +7,8 @@
 #include <utility>
 #include <vector>
 
+#include "io/reindexed_reader.h"
+
 namespace edgeslam {
 namespace {
 
@@ -17,44 +19,6 @@ bool allDigits(const std::string& text) {
   }
   return true;
 }
-
-class FrameRangeReader : public DatasetReader {
- public:
-  FrameRangeReader(std::unique_ptr<DatasetReader> inner, const FrameRange& range)
-      : inner_(std::move(inner)), first_(range.first), info_(inner_->info()) {
-    info_.frame_count = range.count();
-    const auto begin = static_cast<std::ptrdiff_t>(range.first);
-    const auto end = static_cast<std::ptrdiff_t>(range.last + 1);
-    timestamps_.assign(inner_->timestamps().begin() + begin, inner_->timestamps().begin() + end);
-    ground_truth_.assign(inner_->groundTruth().begin() + begin,
-                         inner_->groundTruth().begin() + end);
-    info_.has_ground_truth = false;
-    for (const auto& pose : ground_truth_) info_.has_ground_truth |= pose.has_value();
-  }
-
-  const DatasetInfo& info() const override { return info_; }
-  const PinholeCamera& camera() const override { return inner_->camera(); }
-  const std::vector<double>& timestamps() const override { return timestamps_; }
-  const std::vector<std::optional<SE3d>>& groundTruth() const override { return ground_truth_; }
-
-  DatasetFrame load(std::size_t index) override {
-    if (index >= info_.frame_count) {
-      throw std::out_of_range(
-          fmt::format("frame {} of a {}-frame range", index, info_.frame_count));
-    }
-    inner_->setContent(content());
-    DatasetFrame frame = inner_->load(first_ + index);
-    frame.index = index;
-    return frame;
-  }
-
- private:
-  std::unique_ptr<DatasetReader> inner_;
-  std::size_t first_;
-  DatasetInfo info_;
-  std::vector<double> timestamps_;
-  std::vector<std::optional<SE3d>> ground_truth_;
-};
 
 }  // namespace
 
@@ -86,7 +50,15 @@ std::unique_ptr<DatasetReader> selectFrames(std::unique_ptr<DatasetReader> reade
                                             const FrameRange& range) {
   checkFrameRange(range, reader->info().frame_count);
   if (range.first == 0 && range.count() == reader->info().frame_count) return reader;
-  return std::make_unique<FrameRangeReader>(std::move(reader), range);
+  std::vector<std::size_t> inner_index(range.count());
+  std::vector<double> timestamps(range.count());
+  for (std::size_t i = 0; i < range.count(); ++i) {
+    inner_index[i] = range.first + i;
+    timestamps[i] = reader->timestamps()[range.first + i];
+  }
+  return std::make_unique<ReindexedReader>(std::move(reader), std::move(inner_index),
+                                           std::move(timestamps),
+                                           fmt::format("a {}-frame range", range.count()));
 }
 
 }  // namespace edgeslam

@@ -6,6 +6,8 @@
 #include <utility>
 #include <vector>
 
+#include "io/reindexed_reader.h"
+
 namespace edgeslam {
 namespace {
 
@@ -19,54 +21,28 @@ double passPeriod(const std::vector<double>& stamps, double fps) {
   return stamps.back() - stamps.front() + interval;
 }
 
-class RepeatedReader : public DatasetReader {
- public:
-  RepeatedReader(std::unique_ptr<DatasetReader> inner, std::size_t passes)
-      : inner_(std::move(inner)), count_(inner_->info().frame_count), info_(inner_->info()) {
-    info_.frame_count = count_ * passes;
-    const std::vector<double>& stamps = inner_->timestamps();
-    const double period = passPeriod(stamps, info_.fps);
-    timestamps_.reserve(info_.frame_count);
-    ground_truth_.reserve(info_.frame_count);
-    for (std::size_t pass = 0; pass < passes; ++pass) {
-      for (double t : stamps) timestamps_.push_back(t + static_cast<double>(pass) * period);
-      ground_truth_.insert(ground_truth_.end(), inner_->groundTruth().begin(),
-                           inner_->groundTruth().end());
-    }
-  }
-
-  const DatasetInfo& info() const override { return info_; }
-  const PinholeCamera& camera() const override { return inner_->camera(); }
-  const std::vector<double>& timestamps() const override { return timestamps_; }
-  const std::vector<std::optional<SE3d>>& groundTruth() const override { return ground_truth_; }
-
-  DatasetFrame load(std::size_t index) override {
-    if (index >= info_.frame_count) {
-      throw std::out_of_range(
-          fmt::format("frame {} of {} frames played repeatedly", index, info_.frame_count));
-    }
-    inner_->setContent(content());
-    DatasetFrame frame = inner_->load(index % count_);
-    frame.index = index;
-    frame.timestamp = timestamps_[index];
-    return frame;
-  }
-
- private:
-  std::unique_ptr<DatasetReader> inner_;
-  std::size_t count_;
-  DatasetInfo info_;
-  std::vector<double> timestamps_;
-  std::vector<std::optional<SE3d>> ground_truth_;
-};
-
 }  // namespace
 
 std::unique_ptr<DatasetReader> repeatFrames(std::unique_ptr<DatasetReader> reader,
                                             std::size_t passes) {
   if (passes == 0) throw std::invalid_argument("a sequence is played at least once");
   if (passes == 1 || reader->info().frame_count == 0) return reader;
-  return std::make_unique<RepeatedReader>(std::move(reader), passes);
+  const std::size_t count = reader->info().frame_count;
+  const std::vector<double>& stamps = reader->timestamps();
+  const double period = passPeriod(stamps, reader->info().fps);
+  std::vector<std::size_t> inner_index;
+  std::vector<double> timestamps;
+  inner_index.reserve(count * passes);
+  timestamps.reserve(count * passes);
+  for (std::size_t pass = 0; pass < passes; ++pass) {
+    for (std::size_t i = 0; i < count; ++i) {
+      inner_index.push_back(i);
+      timestamps.push_back(stamps[i] + static_cast<double>(pass) * period);
+    }
+  }
+  return std::make_unique<ReindexedReader>(std::move(reader), std::move(inner_index),
+                                           std::move(timestamps),
+                                           fmt::format("{} frames played {} times", count, passes));
 }
 
 }  // namespace edgeslam
