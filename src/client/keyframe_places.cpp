@@ -38,6 +38,15 @@ std::shared_ptr<const KeyFramePlace> KeyFramePlaces::add(const KeyFrame& keyfram
   return place;
 }
 
+std::size_t KeyFramePlaces::forgetIf(const std::function<bool(KeyFrameId)>& gone) {
+  std::vector<KeyFrameId> forgotten;
+  for (const auto& [id, place] : places_) {
+    if (gone(id)) forgotten.push_back(id);
+  }
+  for (KeyFrameId id : forgotten) erase(id);
+  return forgotten.size();
+}
+
 void KeyFramePlaces::erase(KeyFrameId id) {
   database_.erase(id);
   places_.erase(id);

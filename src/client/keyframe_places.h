@@ -2,6 +2,7 @@
 // The client's place recognition: every keyframe it makes goes into a bag-of-words database, so
 // that a lost frame can find the keyframes that look like it (relocalisation), and be matched to
 // them word by word.
+#include <functional>
 #include <memory>
 #include <unordered_map>
 #include <vector>
@@ -24,6 +25,8 @@ class KeyFramePlaces {
   // A keyframe the client no longer holds (evicted from its bounded map); no-op when unknown.
   void erase(KeyFrameId id);
   void clear();
+  // Forgets every keyframe `gone` says the map no longer has; returns how many.
+  std::size_t forgetIf(const std::function<bool(KeyFrameId)>& gone);
   std::size_t size() const { return places_.size(); }
 
   // Indexes a frame to look up, and returns the ids of the stored keyframes most similar to it,

@@ -44,7 +44,8 @@ Tracker::Tracker(Map& map, const PinholeCamera& camera, TrackerOptions options, 
       camera_(camera),
       options_(std::move(options)),
       sink_(sink),
-      mono_init_(camera, options_.monocular_init) {
+      mono_init_(camera, options_.monocular_init),
+      map_participant_(map, "tracking") {
   if (options_.vocabulary) places_ = std::make_unique<KeyFramePlaces>(options_.vocabulary);
 }
 
@@ -104,6 +105,7 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
   bool recovered = false;  // by the motion prediction, after some lost frames
   {
     std::lock_guard lock(map_.updateMutex());
+    releaseErased();
     if (last_frame_ && last_frame_->T_cw) {
       // The last frame's keyframe may have moved since (local BA): follow it.
       const FrameRecord& last_record = records_.back();
@@ -656,6 +658,22 @@ void Tracker::record(const Frame& frame, bool tracked) {
   records_.push_back(r);
 }
 
+void Tracker::releaseErased() {
+  if (last_frame_) {
+    for (MapPoint*& p : last_frame_->points) {
+      if (p != nullptr && p->isBad()) p = nullptr;
+    }
+  }
+  std::erase_if(local_points_, [](const MapPoint* p) { return p->isBad(); });
+  std::erase_if(local_keyframes_, [](const KeyFrame* kf) { return kf->isBad(); });
+  // Erased keyframes leave the relocalisation database a few dozen at a time.
+  constexpr std::size_t kForgetEvery = 32;
+  if (places_ && places_->size() > map_.heldKeyFrameCount() + kForgetEvery) {
+    places_->forgetIf([this](KeyFrameId id) { return map_.keyFrame(id) == nullptr; });
+  }
+  map_participant_.quiescent();
+}
+
 void Tracker::resetMap() {
   std::lock_guard lock(map_.updateMutex());
   map_.clear();
@@ -672,6 +690,7 @@ void Tracker::resetMap() {
   local_points_.clear();
   frames_lost_ = 0;
   ++resets_;
+  map_participant_.quiescent();  // nothing of the old map is held any more
 }
 
 }  // namespace edgeslam

@@ -136,6 +136,9 @@ class Tracker {
   void triangulateAtKeyFrame(KeyFrame* keyframe, Frame& frame);
   void record(const Frame& frame, bool tracked);
   void resetMap();
+  // Under the map's mutex, at the start of each frame: lets go of erased points and keyframes so
+  // that the map can free them (MapParticipant).
+  void releaseErased();
   void reportFeaturePositions(const Frame& frame, TrackResult& result) const;
 
   Map& map_;
@@ -144,6 +147,7 @@ class Tracker {
   KeyFrameSink* sink_;
   MonocularInitializer mono_init_;
   std::unique_ptr<KeyFramePlaces> places_;
+  MapParticipant map_participant_;
 
   TrackingState state_ = TrackingState::kNotInitialized;
   std::optional<Frame> last_frame_;

@@ -24,7 +24,10 @@ std::optional<TriangulationSearch> parseTriangulationSearch(std::string_view tex
 }
 
 LocalMapper::LocalMapper(Map& map, const PinholeCamera& camera, LocalMapperOptions options)
-    : map_(map), camera_(camera), options_(std::move(options)) {}
+    : map_(map),
+      camera_(camera),
+      options_(std::move(options)),
+      map_participant_(map, "local mapping") {}
 
 LocalMapper::~LocalMapper() {
   stop();
@@ -130,6 +133,7 @@ void LocalMapper::processAll() {
     }
     abort_ba_ = false;
     processKeyFrame(kf);
+    releaseErased();
   }
 }
 
@@ -152,7 +156,14 @@ void LocalMapper::run() {
       abort_ba_ = false;
     }
     processKeyFrame(kf);
+    releaseErased();
   }
+}
+
+void LocalMapper::releaseErased() {
+  std::lock_guard lock(map_.updateMutex());
+  recent_points_.remove_if([](const MapPoint* p) { return p->isBad(); });
+  map_participant_.quiescent();
 }
 
 void LocalMapper::processKeyFrame(KeyFrame* keyframe) {
@@ -189,6 +200,11 @@ void LocalMapper::describe(KeyFrame* keyframe) const {
 
 void LocalMapper::mapKeyFrame(KeyFrame* keyframe) {
   if (reset_requested_.exchange(false)) recent_points_.clear();
+  {
+    // Once erased, a keyframe's features may be freed at any quiescent point.
+    std::lock_guard lock(map_.updateMutex());
+    if (keyframe->isBad()) return;
+  }
   describe(keyframe);
   {
     std::lock_guard lock(map_.updateMutex());

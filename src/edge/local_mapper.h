@@ -144,10 +144,13 @@ class LocalMapper : public KeyFrameSink {
   // Culls `keyframe` itself when an older keyframe covers its view (cull_revisits).
   bool cullRevisit(KeyFrame* keyframe);
   bool hasPending() const;
+  // Between keyframes: lets go of erased points so that the map can free them.
+  void releaseErased();
 
   Map& map_;
   const PinholeCamera& camera_;
   LocalMapperOptions options_;
+  MapParticipant map_participant_;
 
   mutable std::mutex queue_mutex_;
   std::condition_variable queue_cv_;

@@ -24,6 +24,7 @@ LoopCloser::LoopCloser(Map& map, const PinholeCamera& camera,
     : map_(map),
       camera_(camera),
       options_(std::move(options)),
+      map_participant_(map, "loop closing"),
       mapper_(mapper),
       detector_(std::move(vocabulary), options_.detector) {}
 
@@ -93,6 +94,7 @@ void LoopCloser::processAll() {
       queue_.pop_front();
     }
     processKeyFrame(keyframe);
+    releaseErased();
   }
 }
 
@@ -138,7 +140,18 @@ void LoopCloser::run() {
       busy_ = true;
     }
     processKeyFrame(keyframe);
+    releaseErased();
   }
+}
+
+void LoopCloser::releaseErased() {
+  std::lock_guard lock(map_.updateMutex());
+  // Erased keyframes leave the place database a few dozen at a time.
+  constexpr std::size_t kForgetEvery = 32;
+  if (detector_.describedCount() > map_.keyFrameCount() + kForgetEvery) {
+    detector_.forgetIf([this](KeyFrameId id) { return map_.keyFrame(id) == nullptr; });
+  }
+  map_participant_.quiescent();
 }
 
 void LoopCloser::processKeyFrame(KeyFrame* keyframe) {
@@ -255,7 +268,10 @@ void LoopCloser::launchGlobalBundleAdjustment() {
   MutexLock lock(global_ba_mutex_);
   cancel_global_ba_ = false;
   if (options_.threaded) {
-    global_ba_thread_.start("global bundle adjustment", [this] { globalBundleAdjustment(); });
+    global_ba_thread_.start("global bundle adjustment", [this] {
+      MapParticipant participant(map_, "global bundle adjustment");
+      globalBundleAdjustment();
+    });
   } else {
     globalBundleAdjustment();
   }

@@ -114,10 +114,13 @@ class LoopCloser {
   void launchGlobalBundleAdjustment();
   void globalBundleAdjustment();
   void stopGlobalBundleAdjustment();
+  // Between keyframes: lets go of erased keyframes so that the map can free them.
+  void releaseErased();
 
   Map& map_;
   const PinholeCamera& camera_;
   LoopCloserOptions options_;
+  MapParticipant map_participant_;
   LocalMapper* mapper_;
   LoopDetector detector_;
   std::size_t keyframes_since_loop_ = 0;

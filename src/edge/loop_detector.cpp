@@ -50,6 +50,26 @@ void LoopDetector::clear() {
   consistency_.reset();
 }
 
+std::size_t LoopDetector::forgetIf(const std::function<bool(KeyFrameId)>& gone) {
+  MutexLock lock(bow_mutex_);
+  std::size_t forgotten = 0;
+  for (auto it = bows_.begin(); it != bows_.end();) {
+    if (gone(it->first)) {
+      database_.erase(it->first);
+      it = bows_.erase(it);
+      ++forgotten;
+    } else {
+      ++it;
+    }
+  }
+  return forgotten;
+}
+
+std::size_t LoopDetector::describedCount() const {
+  MutexLock lock(bow_mutex_);
+  return bows_.size();
+}
+
 LoopDetection LoopDetector::detect(KeyFrame* keyframe, const Map& map, bool search, bool store) {
   const KeyFrameBow* own = bowOf(keyframe->id());
   if (own == nullptr) {

@@ -6,6 +6,7 @@
 // covisible keyframe does; hits are pooled by covisibility group and must be temporally
 // consistent (loop_consistency.h) before they are handed on to geometric verification.
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <unordered_map>
 #include <vector>
@@ -65,6 +66,10 @@ class LoopDetector {
   void resetConsistency() { consistency_.reset(); }
   // Drops everything (map reset).
   void clear();
+  // Forgets the keyframes `gone` says the map no longer has: their bags of words and database
+  // entries. Returns how many.
+  std::size_t forgetIf(const std::function<bool(KeyFrameId)>& gone);
+  std::size_t describedCount() const;
   std::size_t databaseSize() const { return database_.size(); }
   const LoopDetectorOptions& options() const { return options_; }
 

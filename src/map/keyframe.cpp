@@ -23,6 +23,18 @@ void KeyFrame::setPose(const SE3d& T_cw) {
   T_wc_ = T_cw.inverse();
 }
 
+void KeyFrame::dropFeatures() {
+  auto empty = std::make_shared<FrameFeatures>();
+  empty->scales = features_->scales;
+  empty->bf = features_->bf;
+  features_ = std::move(empty);
+  points_.clear();
+  points_.shrink_to_fit();
+  connection_weights_.clear();
+  ordered_connections_.clear();
+  ordered_connections_.shrink_to_fit();
+}
+
 SE3d KeyFrame::latestPose() const {
   SE3d relative;
   const KeyFrame* kf = this;

@@ -91,6 +91,8 @@ class KeyFrame {
   friend class Map;
   void setPose(const SE3d& T_cw);
   void updateConnections();  // recomputes covisibility from shared points; sets parent if none
+  // Keeps only what projections need of the features (scales, bf): an evicted or erased keyframe.
+  void dropFeatures();
 
   KeyFrameId id_;
   std::size_t frame_index_;

@@ -104,7 +104,7 @@ void Map::erasePoint(MapPoint* point) {
   point->observation_weight_ = 0;
   record().pointErased(point->id());
   auto node = points_.extract(point->id());
-  if (!node.empty()) retired_points_.push_back(std::move(node.mapped()));
+  if (!node.empty()) retire(std::move(node.mapped()));
 }
 
 void Map::replacePoint(MapPoint* old_point, MapPoint* replacement) {
@@ -190,11 +190,7 @@ void Map::evictKeyFrame(KeyFrame* keyframe) {
     // Not eraseObservation: a point the replica still sees once stays (the owner culls points).
     if (MapPoint* p = keyframe->points_[i]) detachObservation(p, keyframe);
   }
-  auto empty = std::make_shared<FrameFeatures>();
-  empty->scales = keyframe->features_->scales;
-  empty->bf = keyframe->features_->bf;
-  keyframe->features_ = std::move(empty);
-  keyframe->points_.clear();
+  keyframe->dropFeatures();
   keyframe->evicted_ = true;
   ++evicted_keyframes_;
 }
@@ -254,7 +250,7 @@ void Map::eraseKeyFrame(KeyFrame* keyframe) {
   if (keyframe->evicted_) --evicted_keyframes_;
   record().keyFrameErased(keyframe->id());
   auto node = keyframes_.extract(keyframe->id());
-  if (!node.empty()) retired_keyframes_.push_back(std::move(node.mapped()));
+  if (!node.empty()) retire(std::move(node.mapped()));
 }
 
 void Map::addLoopEdge(KeyFrame* a, KeyFrame* b) {
@@ -269,11 +265,11 @@ void Map::addLoopEdge(KeyFrame* a, KeyFrame* b) {
 void Map::clear() {
   for (auto& [id, p] : points_) {
     p->bad_ = true;
-    retired_points_.push_back(std::move(p));
+    retire(std::move(p));
   }
   for (auto& [id, kf] : keyframes_) {
     kf->bad_ = true;
-    retired_keyframes_.push_back(std::move(kf));
+    retire(std::move(kf));
   }
   points_.clear();
   keyframes_.clear();
@@ -318,6 +314,60 @@ KeyFrame* Map::keyFrame(KeyFrameId id) const {
 MapPoint* Map::mapPoint(MapPointId id) const {
   const auto it = points_.find(id);
   return it == points_.end() ? nullptr : it->second.get();
+}
+
+void Map::retire(std::unique_ptr<MapPoint> point) {
+  retired_points_.push_back({++erasures_, std::move(point)});
+}
+
+void Map::retire(std::unique_ptr<KeyFrame> keyframe) {
+  keyframes_to_release_.push_back({++erasures_, keyframe.get()});
+  erased_keyframes_.push_back(std::move(keyframe));
+}
+
+void Map::reclaim() {
+  if (participants_.empty()) return;
+  std::uint64_t safe = erasures_;
+  for (const MapParticipant* participant : participants_) {
+    safe = std::min(safe, participant->safe_through_);
+  }
+  // Both queues are in erasure order.
+  while (!retired_points_.empty() && retired_points_.front().erasure <= safe) {
+    retired_points_.pop_front();
+    ++reclaimed_.points_freed;
+  }
+  while (!keyframes_to_release_.empty() && keyframes_to_release_.front().erasure <= safe) {
+    KeyFrame* keyframe = keyframes_to_release_.front().keyframe;
+    keyframe->dropFeatures();
+    keyframe->place_.store(nullptr);
+    keyframes_to_release_.pop_front();
+    ++reclaimed_.keyframes_released;
+  }
+}
+
+Map::Reclamation Map::reclamation() const {
+  Reclamation out = reclaimed_;
+  out.points_waiting = retired_points_.size();
+  out.keyframes_waiting = keyframes_to_release_.size();
+  out.participants = participants_.size();
+  return out;
+}
+
+MapParticipant::MapParticipant(Map& map, std::string name) : map_(map), name_(std::move(name)) {
+  std::lock_guard lock(map_.updateMutex());
+  safe_through_ = map_.erasures_;
+  map_.participants_.push_back(this);
+}
+
+MapParticipant::~MapParticipant() {
+  std::lock_guard lock(map_.updateMutex());
+  std::erase(map_.participants_, this);
+  map_.reclaim();
+}
+
+void MapParticipant::quiescent() {
+  safe_through_ = map_.erasures_;
+  map_.reclaim();
 }
 
 MapChanges& Map::record() {

@@ -4,8 +4,11 @@
 //
 // Thread safety: callers hold updateMutex() around any sequence of calls that reads or changes the
 // map from more than one thread (tracking holds it for a frame; mapping for each change it
-// applies). Erased elements stay allocated until the Map is destroyed, so raw pointers never
-// dangle.
+// applies). An erased element stays allocated until every thread that keeps pointers beyond the
+// mutex (a MapParticipant) has passed a quiescent point; then an erased point is freed and an
+// erased keyframe drops its features, leaving its pose in the spanning tree.
+#include <cstdint>
+#include <deque>
 #include <memory>
 #include <mutex>
 #include <unordered_map>
@@ -13,6 +16,7 @@
 
 #include "map/keyframe.h"
 #include "map/map_changes.h"
+#include "map/map_participant.h"
 #include "map/map_point.h"
 
 namespace edgeslam {
@@ -89,13 +93,38 @@ class Map {
 
   IdAllocator& ids() { return ids_; }
 
+  // Erased elements freed so far, and those still waiting for a participant's quiescent point.
+  struct Reclamation {
+    std::uint64_t points_freed = 0;
+    std::uint64_t keyframes_released = 0;  // features dropped; the erased keyframe stays
+    std::size_t points_waiting = 0;
+    std::size_t keyframes_waiting = 0;
+    std::size_t participants = 0;
+  };
+  Reclamation reclamation() const;
+
  private:
+  friend class MapParticipant;
+  struct RetiredPoint {
+    std::uint64_t erasure;
+    std::unique_ptr<MapPoint> point;
+  };
+  struct RetiredKeyFrame {
+    std::uint64_t erasure;
+    KeyFrame* keyframe;  // owned by erased_keyframes_
+  };
+
   mutable std::mutex update_mutex_;
   IdAllocator ids_;
   std::unordered_map<KeyFrameId, std::unique_ptr<KeyFrame>> keyframes_;
   std::unordered_map<MapPointId, std::unique_ptr<MapPoint>> points_;
-  std::vector<std::unique_ptr<KeyFrame>> retired_keyframes_;
-  std::vector<std::unique_ptr<MapPoint>> retired_points_;
+  // Erasures are numbered; participants say through which number they hold nothing erased.
+  std::uint64_t erasures_ = 0;
+  std::deque<RetiredPoint> retired_points_;
+  std::deque<RetiredKeyFrame> keyframes_to_release_;
+  std::vector<std::unique_ptr<KeyFrame>> erased_keyframes_;
+  std::vector<MapParticipant*> participants_;
+  Reclamation reclaimed_;
   KeyFrame* origin_ = nullptr;
   std::size_t evicted_keyframes_ = 0;  // live (not erased) keyframes that are evicted
   MapChanges changes_;
@@ -103,6 +132,11 @@ class Map {
   bool recording_ = true;
 
   MapChanges& record();
+  void retire(std::unique_ptr<MapPoint> point);
+  void retire(std::unique_ptr<KeyFrame> keyframe);
+  // Frees what every participant has passed. Called from a quiescent point only: a map nobody
+  // participates in keeps its erased elements until it is destroyed.
+  void reclaim();
   void unlinkConnections(KeyFrame* keyframe);  // covisibility links, both ways
 };
 
