@@ -22,7 +22,6 @@ SlamOptions defaultSlamOptions(const PinholeCamera& camera, Sensor sensor) {
   options.tracker.keyframes.fmax = std::max(1, static_cast<int>(std::lround(40 * rate)));
   options.tracker.keyframes.alpha = 0.3;
   options.tracker.keyframes.beta = 0.9;
-  options.mapper.monocular = sensor == Sensor::kMonocular;
   // Without depth a focal change trades against the map's shape, so a monocular map's own focal
   // estimate is trusted less: on 7-Scenes the monocular map asked for -5.8 % (585 -> 551-558) and
   // its keyframes got worse (ATE 4.23 -> 4.78 cm), while KITTI's -1.1 % takes its turn drift out.
@@ -35,7 +34,6 @@ TrackingSlam::TrackingSlam(const PinholeCamera& camera, SlamOptions options,
                            std::uint8_t map_id_origin)
     : camera_(camera), options_(std::move(options)), extractor_(options_.orb), map_(map_id_origin) {
   options_.tracker.sensor = options_.sensor;
-  options_.mapper.monocular = options_.sensor == Sensor::kMonocular;
   if (options_.semantic) {
     semantic_filter_ = std::make_unique<SemanticFrameFilter>(camera_, options_.semantic_filter);
     validate(options_.segmentation_refresh);

@@ -20,7 +20,7 @@ TEST(EdgeSlam, ClientMapReplicatesTheEdgeMapOnKitti) {
   const PinholeCamera& camera = reader->camera();
   SlamOptions options = defaultSlamOptions(camera, Sensor::kMonocular);
   EdgeMapSessionOptions edge_options;
-  edge_options.threaded = false;
+  edge_options.backend.threaded = false;
   auto link = std::make_unique<InProcessEdgeLink>(camera, Sensor::kMonocular, edge_options);
   InProcessEdgeLink* raw_link = link.get();
   EdgeSlam slam(camera, options, std::move(link));
@@ -66,7 +66,7 @@ TEST(EdgeSlam, BoundedClientMapHoldsTheEdgeWindowOnKitti) {
   const PinholeCamera& camera = reader->camera();
   SlamOptions options = defaultSlamOptions(camera, Sensor::kMonocular);
   EdgeMapSessionOptions edge_options;
-  edge_options.threaded = false;
+  edge_options.backend.threaded = false;
   edge_options.window.keyframes = 6;
   auto link = std::make_unique<InProcessEdgeLink>(camera, Sensor::kMonocular, edge_options);
   InProcessEdgeLink* raw_link = link.get();

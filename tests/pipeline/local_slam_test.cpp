@@ -65,7 +65,7 @@ TEST(LocalSlam, SelfCalibrationTakesTheTurnDriftOutOfKitti) {
   EDGESLAM_REQUIRE_SHARED("datasets/kitti07-160");
   auto reader = openDataset(test::sharedPath("datasets/kitti07-160"));
   SlamOptions options = defaultSlamOptions(reader->camera(), Sensor::kMonocular);
-  options.threaded_mapping = false;  // every keyframe mapped before the next frame: repeatable
+  options.backend.threaded = false;  // every keyframe mapped before the next frame: repeatable
   LocalSlam slam(reader->camera(), options);
   Trajectory ground_truth;
   for (std::size_t i = 0; i < reader->info().frame_count; ++i) {
