@@ -407,9 +407,8 @@ int runPipeline(const RunOptions& given) {
       const LinkTraffic traffic = slam.linkTraffic();
       logged.uplink_bytes = traffic.uplink_bytes;
       logged.downlink_bytes = traffic.downlink_bytes;
-      if (const auto* edge_slam = dynamic_cast<const EdgeSlam*>(&slam);
-          edge_slam != nullptr && edge_slam->adaptation() != nullptr) {
-        logged.adaptation_row = static_cast<int>(edge_slam->adaptation()->row());
+      if (const AdaptationLoop* adaptation = slam.adaptation()) {
+        logged.adaptation_row = static_cast<int>(adaptation->row());
       }
       if (const SemanticFrame* semantic = slam.lastSemanticFrame()) {
         logged.features_culled = semantic->culled;
@@ -558,9 +557,8 @@ int runPipeline(const RunOptions& given) {
                                    {"tracking", toJson(counters.tracking_ms)},
                                    {"keyframe", toJson(counters.keyframe_ms)}};
   }
-  if (const auto* edge_slam = dynamic_cast<const EdgeSlam*>(&slam);
-      edge_slam != nullptr && edge_slam->adaptation() != nullptr) {
-    const AdaptationLoop& loop = *edge_slam->adaptation();
+  if (const AdaptationLoop* adaptation = slam.adaptation()) {
+    const AdaptationLoop& loop = *adaptation;
     const AdaptationLoopCounters c = loop.counters();
     const NetworkEstimates n = loop.estimates();
     const auto optional_json = [](const std::optional<double>& v) {
@@ -581,9 +579,9 @@ int runPipeline(const RunOptions& given) {
          std::min<std::uint64_t>(counters.uplink_bytes, c.probe_uplink_bytes)) /
         keyframes_uploaded;
   }
-  if (const auto* edge_slam = dynamic_cast<const EdgeSlam*>(&slam)) {
+  if (const std::optional<SplitClientReport> split = slam.splitClientReport()) {
     // The client's own map; keyframes / map_points above are the edge's global map.
-    const ClientMapSize c = edge_slam->clientMapSize();
+    const ClientMapSize& c = split->client_map;
     metrics["client_map"] = {{"window_keyframes", options.client_map_keyframes},
                              {"keyframes", c.keyframes},
                              {"points", c.points},
@@ -593,7 +591,7 @@ int runPipeline(const RunOptions& given) {
                              {"keyframes_entered", c.keyframes_entered}};
     // Every keyframe the client made is on the edge, culled there as redundant, on its way, or
     // lost for a reason below.
-    const ResyncCounters r = edge_slam->resyncCounters();
+    const ResyncCounters& r = split->resync;
     metrics["resync"] = {{"full_resyncs", r.full_resyncs},
                          {"keyframes_made", counters.keyframes_uploaded - r.keyframes_resent},
                          {"keyframes_resent", r.keyframes_resent},
@@ -601,7 +599,7 @@ int runPipeline(const RunOptions& given) {
                          {"keyframes_lost",
                           {{"upload_dropped", counters.keyframes_forgotten},
                            {"evicted_before_stored", r.keyframes_lost_evicted}}}};
-    const KeyFrameTriangulationStats& t = edge_slam->clientTriangulation();
+    const KeyFrameTriangulationStats& t = split->triangulation;
     if (t.keyframes > 0) {
       const PercentileSummary ms = t.ms.summary();
       metrics["client_triangulation"] = {
@@ -654,8 +652,8 @@ int runPipeline(const RunOptions& given) {
                  diagnostics->last_refusal);
     }
   }
-  if (const auto* edge_slam = dynamic_cast<const EdgeSlam*>(&slam)) {
-    const ClientMapSize c = edge_slam->clientMapSize();
+  if (const std::optional<SplitClientReport> split = slam.splitClientReport()) {
+    const ClientMapSize& c = split->client_map;
     fmt::print("  client map   {} keyframes, {} points held (at most {} / {}; window {})\n",
                c.keyframes, c.points, c.max_keyframes, c.max_points,
                options.client_map_keyframes > 0 ? std::to_string(options.client_map_keyframes)

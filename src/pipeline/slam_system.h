@@ -19,11 +19,14 @@
 #include "map/map.h"
 #include "optimize/map_optimization.h"
 #include "pipeline/paced_keyframe_sink.h"
+#include "pipeline/split_client_report.h"
 #include "place/vocabulary.h"
 #include "semantic/segmenter.h"
 #include "util/timing_stats.h"
 
 namespace edgeslam {
+
+class AdaptationLoop;
 
 struct SlamOptions {
   Sensor sensor = Sensor::kMonocular;
@@ -176,6 +179,12 @@ class SlamSystem {
   // track (offload).
   virtual const SemanticFrame* lastSemanticFrame() const { return nullptr; }
   virtual ClientStageTimes lastFrameStages() const { return {}; }
+
+  // What a mode alone has; absent elsewhere. The loop that retunes the keyframe rules to the link
+  // (edge mode with adaptation):
+  virtual const AdaptationLoop* adaptation() const { return nullptr; }
+  // The client's side of the split (edge mode):
+  virtual std::optional<SplitClientReport> splitClientReport() const { return std::nullopt; }
 };
 
 // Modes that track on the client against the client's map: feature extraction and tracking on the

@@ -82,6 +82,13 @@ TEST(EdgeSlam, BoundedClientMapHoldsTheEdgeWindowOnKitti) {
   slam.finish();
   EXPECT_GE(tracked, 35u);
   const ClientMapSize size = slam.clientMapSize();
+  // What the run command reads, through the mode-neutral interface.
+  const SlamSystem& system = slam;
+  const std::optional<SplitClientReport> report = system.splitClientReport();
+  ASSERT_TRUE(report.has_value());
+  EXPECT_EQ(report->client_map.keyframes, size.keyframes);
+  EXPECT_EQ(report->client_map.keyframes_evicted, size.keyframes_evicted);
+  EXPECT_EQ(system.adaptation(), nullptr);  // an in-process link does not adapt
   EdgeMapSession& session = raw_link->session();
   Map& edge = session.map();
   std::lock_guard edge_lock(edge.updateMutex());

@@ -35,6 +35,10 @@ RunOutcome runSequence(const std::string& dataset, Sensor sensor, std::size_t fr
     }
   }
   slam.finish();
+  // Nothing of the split to report (the run command writes no client_map or resync for it).
+  const SlamSystem& system = slam;
+  EXPECT_FALSE(system.splitClientReport().has_value());
+  EXPECT_EQ(system.adaptation(), nullptr);
   out.ate_final = computeAte(associateByTimestamp(ground_truth, slam.trajectoryFinal()),
                              sensor == Sensor::kMonocular ? AlignMode::kSim3 : AlignMode::kSe3);
   return out;
