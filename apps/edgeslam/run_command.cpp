@@ -126,7 +126,7 @@ struct EdgeEndpoint {
   }
 };
 
-EdgeEndpoint openEdge(const RunOptions& options, std::shared_ptr<const Vocabulary> vocabulary) {
+EdgeEndpoint openEdge(const RunOptions& options, const MappingBackendOptions& backend) {
   EdgeEndpoint edge;
   if (!options.server_address.empty()) {
     edge.address = options.server_address;
@@ -145,12 +145,12 @@ EdgeEndpoint openEdge(const RunOptions& options, std::shared_ptr<const Vocabular
   SlamSessionOptions session;
   if (options.semantic)
     session.segmenter = segmenterOptions(options.models_dir, options.segment_input);
-  session.mapping.vocabulary = std::move(vocabulary);
-  session.mapping.loop_closing = options.loop_closing;
-  if (options.triangulation_search) {
-    session.mapping.mapper.triangulation_search =
-        *parseTriangulationSearch(*options.triangulation_search);
-  }
+  // The edge session maps and closes loops as local mode would; its threads, their priority and
+  // its segmenter stay the session's own.
+  session.mapping.backend.mapper = backend.mapper;
+  session.mapping.backend.vocabulary = backend.vocabulary;
+  session.mapping.backend.loop_closing = backend.loop_closing;
+  session.mapping.backend.loop_closer = backend.loop_closer;
   // Offload sessions keep no map yet: only edge mode opens the store.
   if (options.mode == "edge") edge.store = openStoreForWriting(options.maps);
   session.store = edge.store.store;
@@ -268,17 +268,17 @@ int runPipeline(const RunOptions& given) {
   slam_options.tracker.recover_within_frames = options.recover_frames;
   // The mobile view draws each feature by state; without a viewer nothing is copied.
   slam_options.tracker.report_feature_positions = options.viewer_port.has_value();
-  slam_options.vocabulary = slam_options.tracker.vocabulary;
-  slam_options.loop_closing = options.loop_closing;
+  slam_options.backend.vocabulary = slam_options.tracker.vocabulary;
+  slam_options.backend.loop_closing = options.loop_closing;
   slam_options.client_triangulation = options.client_triangulation;
   // Paced frames have a deadline and the background has the time between them; unpaced (--fast)
   // tracking always has work, so lowering the mapper would starve it of keyframes.
-  slam_options.background_nice = options.realtime ? kBackgroundNiceWhenPaced : 0;
+  slam_options.backend.thread_nice = options.realtime ? kBackgroundNiceWhenPaced : 0;
   // Unpaced, tracking waits for the back end instead of outrunning it (issue 24: KITTI 03 mono
   // drifted to 2.92 m against 0.71 m paced); paced, a late client drops frames instead.
   slam_options.wait_for_backend = !options.realtime;
   if (options.triangulation_search) {
-    slam_options.mapper.triangulation_search =
+    slam_options.backend.mapper.triangulation_search =
         *parseTriangulationSearch(*options.triangulation_search);
   }
   if (options.deterministic) {
@@ -289,7 +289,7 @@ int runPipeline(const RunOptions& given) {
     }
     // The back end runs inside the tracking thread, after each frame; OpenCV's pool stays out of
     // feature extraction so nothing depends on the order threads finish in.
-    slam_options.threaded_mapping = false;
+    slam_options.backend.threaded = false;
     cv::setNumThreads(1);
   }
   if (options.refine_intrinsics && mode != "local") {
@@ -316,7 +316,7 @@ int runPipeline(const RunOptions& given) {
     // read. A remote edge server checks its own models when the session opens.
     std::shared_ptr<Segmenter> segmenter =
         loadSegmenter(segmenterOptions(options.models_dir, options.segment_input));
-    if (mode == "local") slam_options.segmenter = std::move(segmenter);
+    if (mode == "local") slam_options.backend.segmenter = std::move(segmenter);
   }
   spdlog::info("{} ORB features, {} levels; keyframes fmin {} fmax {} alpha {} beta {}",
                slam_options.orb.num_features, slam_options.orb.num_levels, kf.fmin, kf.fmax,
@@ -329,7 +329,7 @@ int runPipeline(const RunOptions& given) {
         info.path.filename().string().empty() ? std::string("run") : info.path.filename().string());
   }
   const EdgeEndpoint edge =
-      mode == "local" ? EdgeEndpoint{} : openEdge(options, slam_options.vocabulary);
+      mode == "local" ? EdgeEndpoint{} : openEdge(options, slam_options.backend);
   const std::unique_ptr<SlamSystem> slam_system =
       makeSlamSystem(options, mode, reader->camera(), sensor, slam_options, edge);
   SlamSystem& slam = *slam_system;
@@ -407,9 +407,8 @@ int runPipeline(const RunOptions& given) {
       const LinkTraffic traffic = slam.linkTraffic();
       logged.uplink_bytes = traffic.uplink_bytes;
       logged.downlink_bytes = traffic.downlink_bytes;
-      if (const auto* edge_slam = dynamic_cast<const EdgeSlam*>(&slam);
-          edge_slam != nullptr && edge_slam->adaptation() != nullptr) {
-        logged.adaptation_row = static_cast<int>(edge_slam->adaptation()->row());
+      if (const AdaptationLoop* adaptation = slam.adaptation()) {
+        logged.adaptation_row = static_cast<int>(adaptation->row());
       }
       if (const SemanticFrame* semantic = slam.lastSemanticFrame()) {
         logged.features_culled = semantic->culled;
@@ -558,9 +557,8 @@ int runPipeline(const RunOptions& given) {
                                    {"tracking", toJson(counters.tracking_ms)},
                                    {"keyframe", toJson(counters.keyframe_ms)}};
   }
-  if (const auto* edge_slam = dynamic_cast<const EdgeSlam*>(&slam);
-      edge_slam != nullptr && edge_slam->adaptation() != nullptr) {
-    const AdaptationLoop& loop = *edge_slam->adaptation();
+  if (const AdaptationLoop* adaptation = slam.adaptation()) {
+    const AdaptationLoop& loop = *adaptation;
     const AdaptationLoopCounters c = loop.counters();
     const NetworkEstimates n = loop.estimates();
     const auto optional_json = [](const std::optional<double>& v) {
@@ -581,9 +579,9 @@ int runPipeline(const RunOptions& given) {
          std::min<std::uint64_t>(counters.uplink_bytes, c.probe_uplink_bytes)) /
         keyframes_uploaded;
   }
-  if (const auto* edge_slam = dynamic_cast<const EdgeSlam*>(&slam)) {
+  if (const std::optional<SplitClientReport> split = slam.splitClientReport()) {
     // The client's own map; keyframes / map_points above are the edge's global map.
-    const ClientMapSize c = edge_slam->clientMapSize();
+    const ClientMapSize& c = split->client_map;
     metrics["client_map"] = {{"window_keyframes", options.client_map_keyframes},
                              {"keyframes", c.keyframes},
                              {"points", c.points},
@@ -593,7 +591,7 @@ int runPipeline(const RunOptions& given) {
                              {"keyframes_entered", c.keyframes_entered}};
     // Every keyframe the client made is on the edge, culled there as redundant, on its way, or
     // lost for a reason below.
-    const ResyncCounters r = edge_slam->resyncCounters();
+    const ResyncCounters& r = split->resync;
     metrics["resync"] = {{"full_resyncs", r.full_resyncs},
                          {"keyframes_made", counters.keyframes_uploaded - r.keyframes_resent},
                          {"keyframes_resent", r.keyframes_resent},
@@ -601,7 +599,7 @@ int runPipeline(const RunOptions& given) {
                          {"keyframes_lost",
                           {{"upload_dropped", counters.keyframes_forgotten},
                            {"evicted_before_stored", r.keyframes_lost_evicted}}}};
-    const KeyFrameTriangulationStats& t = edge_slam->clientTriangulation();
+    const KeyFrameTriangulationStats& t = split->triangulation;
     if (t.keyframes > 0) {
       const PercentileSummary ms = t.ms.summary();
       metrics["client_triangulation"] = {
@@ -654,8 +652,8 @@ int runPipeline(const RunOptions& given) {
                  diagnostics->last_refusal);
     }
   }
-  if (const auto* edge_slam = dynamic_cast<const EdgeSlam*>(&slam)) {
-    const ClientMapSize c = edge_slam->clientMapSize();
+  if (const std::optional<SplitClientReport> split = slam.splitClientReport()) {
+    const ClientMapSize& c = split->client_map;
     fmt::print("  client map   {} keyframes, {} points held (at most {} / {}; window {})\n",
                c.keyframes, c.points, c.max_keyframes, c.max_points,
                options.client_map_keyframes > 0 ? std::to_string(options.client_map_keyframes)

@@ -48,7 +48,7 @@ int runServer(const ServerOptions& o) {
   std::unique_ptr<ServerViewer> viewer;
   if (o.viewer_port) viewer = std::make_unique<ServerViewer>(o.viewer_host, *o.viewer_port);
   SlamSessionOptions options;
-  options.mapping.vocabulary = loadVocabulary(o.vocabulary);
+  options.mapping.backend.vocabulary = loadVocabulary(o.vocabulary);
   if (o.semantic != "off") {
     const SegmenterOptions segmenter = segmenterOptions(o.models_dir, o.segment_input);
     try {

@@ -6,7 +6,6 @@
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 
-#include "edge/movable_points.h"
 #include "edge/omitted_descriptors.h"
 #include "edge/slice_builder.h"
 #include "map/map_replication.h"
@@ -15,44 +14,29 @@
 
 namespace edgeslam {
 
+MappingBackendOptions edgeSessionBackendOptions() {
+  MappingBackendOptions options;
+  options.thread_nice_when_segmenting = 10;
+  return options;
+}
+
 EdgeMapSession::EdgeMapSession(const PinholeCamera& camera, Sensor sensor,
                                EdgeMapSessionOptions options, Publish publish)
     : camera_(camera),
       mask_downscale_(std::max(1, options.mask_downscale)),
-      movable_point_erode_px_(options.movable_point_erode_px),
       publish_(std::move(publish)),
-      threaded_(options.threaded),
       window_(options.window) {
-  options.mapper.monocular = sensor == Sensor::kMonocular;
-  // The session's vocabulary serves the mapper's bag-of-words triangulation search too.
-  if (!options.mapper.vocabulary) options.mapper.vocabulary = options.vocabulary;
-  const int mapping_nice =
-      options.segmenter != nullptr
-          ? std::max(options.mapper.thread_nice, options.mapping_nice_when_segmenting)
-          : options.mapper.thread_nice;
-  options.mapper.thread_nice = mapping_nice;
-  mapper_ = std::make_unique<LocalMapper>(map_, camera_, options.mapper);
+  MappingBackendHooks hooks;
+  hooks.keyframe_mapped = [this](KeyFrame* keyframe) { publishSlice(keyframe); };
+  hooks.map_corrected = [this] { publishSlice(nullptr); };
+  hooks.keyframe_segmented = [this](KeyFrameSegmentationResult result) {
+    onSegmented(std::move(result));
+  };
+  backend_ = std::make_unique<MappingBackend>(map_, camera_, sensor, std::move(options.backend),
+                                              std::move(hooks));
   if (options.preload) options.preload(map_);
-  if (options.vocabulary != nullptr && options.loop_closing) {
-    LoopCloserOptions loop = loopCloserOptionsFor(sensor);
-    loop.threaded = threaded_;
-    loop.thread_nice = std::max(loop.thread_nice, mapping_nice);
-    loop_closer_ =
-        std::make_unique<LoopCloser>(map_, camera_, options.vocabulary, loop, mapper_.get());
-    loop_closer_->setMapCorrectedCallback([this] { publishSlice(nullptr); });
-  }
   adoptPreloadedMap();
-  if (loop_closer_) loop_closer_->start();
-  mapper_->setKeyFrameMappedCallback([this](KeyFrame* kf) {
-    publishSlice(kf);
-    if (loop_closer_) loop_closer_->insertKeyFrame(kf);
-  });
-  if (options.segmenter != nullptr) {
-    segmentation_ = std::make_unique<KeyFrameSegmentationWorker>(
-        options.segmenter,
-        [this](KeyFrameSegmentationResult result) { onSegmented(std::move(result)); });
-  }
-  if (threaded_) mapper_->start();
+  backend_->start();
 }
 
 void EdgeMapSession::adoptPreloadedMap() {
@@ -70,10 +54,7 @@ void EdgeMapSession::adoptPreloadedMap() {
   if (loaded.empty()) return;
   // Before the threads start: nothing else touches the keyframes' places or the loop database.
   Stopwatch timer;
-  for (KeyFrame* keyframe : loaded) {
-    mapper_->describe(keyframe);
-    if (loop_closer_) loop_closer_->fileKeyFrame(keyframe);
-  }
+  backend_->adoptLoadedKeyFrames(loaded);
   std::lock_guard state(state_mutex_);
   newest_keyframe_ = newest;
   stats_.keyframes_loaded = loaded.size();
@@ -93,14 +74,12 @@ EdgeMapSession::~EdgeMapSession() {
 }
 
 void EdgeMapSession::stop() {
-  if (segmentation_) segmentation_->stop();
-  if (loop_closer_) loop_closer_->stop();
-  mapper_->stop();
+  backend_->stop();
 }
 
 void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
   cv::Mat image;
-  if (segmentation_ != nullptr && !upload.image_bytes.empty()) {
+  if (backend_->segments() && !upload.image_bytes.empty()) {
     image = cv::imdecode(upload.image_bytes, cv::IMREAD_UNCHANGED);
     if (image.empty() || (image.type() != CV_8UC1 && image.type() != CV_8UC3)) {
       throw std::invalid_argument("keyframe image (" + upload.image_encoding + ", " +
@@ -123,8 +102,7 @@ void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
       return;
     }
     if (upload.map_reset) {
-      mapper_->onMapReset();
-      if (loop_closer_) loop_closer_->onMapReset();
+      backend_->onMapReset();
       map_.clear();
       if (observer_ != nullptr) observer_->onMapCleared();
       window_.clear();
@@ -184,19 +162,13 @@ void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
     upload_of_keyframe_[keyframe->id()] = upload.sequence;
     newest_keyframe_ = keyframe->id();
   }
-  if (segmentation_ != nullptr && upload.segmenter_nms > 0.f) {
-    segmentation_->setNmsThreshold(upload.segmenter_nms);
-  }
+  if (upload.segmenter_nms > 0.f) backend_->setNmsThreshold(upload.segmenter_nms);
   if (!image.empty()) {
-    segmentation_->submit({keyframe->id(), keyframe->frameIndex(), std::move(image),
-                           cv::Size(camera_.width(), camera_.height())});
-    if (!threaded_) segmentation_->waitUntilIdle();
+    backend_->segment({keyframe->id(), keyframe->frameIndex(), std::move(image),
+                       cv::Size(camera_.width(), camera_.height())});
   }
-  mapper_->insertKeyFrame(keyframe);
-  if (!threaded_) {
-    mapper_->processAll();
-    if (loop_closer_) loop_closer_->processAll();
-  }
+  backend_->insertKeyFrame(keyframe);
+  backend_->processAll();
 }
 
 void EdgeMapSession::publishSlice(KeyFrame* mapped, std::uint64_t answers) {
@@ -204,7 +176,7 @@ void EdgeMapSession::publishSlice(KeyFrame* mapped, std::uint64_t answers) {
   MapSlice slice;
   {
     std::lock_guard lock(map_.updateMutex());
-    const std::size_t loops = loop_closer_ ? loop_closer_->loops() : 0;
+    const std::size_t loops = backend_->loops();
     std::vector<MaskRecord> masks;
     {
       std::lock_guard state(state_mutex_);
@@ -284,7 +256,7 @@ void EdgeMapSession::publishFullResync() {
     // Points are attached only to keyframes the client holds; a bounded client ignores the rest.
     slice.map_keyframes = map_.keyFrameCount();
     slice.map_points = map_.pointCount();
-    const std::size_t loops = loop_closer_ ? loop_closer_->loops() : 0;
+    const std::size_t loops = backend_->loops();
     slice.loops_closed = static_cast<std::uint32_t>(loops - loops_published_);
     loops_published_ = loops;
     std::lock_guard state(state_mutex_);
@@ -298,50 +270,39 @@ void EdgeMapSession::publishFullResync() {
 }
 
 void EdgeMapSession::onSegmented(KeyFrameSegmentationResult result) {
+  // The back end has erased the keyframe's movable points; the mask goes to the client with them.
   MaskRecord mask;
   mask.keyframe = result.keyframe;
   mask.bytes = encodeLabelImage(result.labels, mask_downscale_, mask.encoding);
   mask.width = (result.labels.cols + mask_downscale_ - 1) / mask_downscale_;
   mask.height = (result.labels.rows + mask_downscale_ - 1) / mask_downscale_;
   mask.segmentation_ms = result.segmentation_ms;
-  std::size_t erased = 0;
   {
-    std::lock_guard lock(map_.updateMutex());
-    KeyFrame* keyframe = map_.keyFrame(result.keyframe);
-    // A keyframe culled meanwhile: the mask still helps the client's transfer.
-    if (keyframe != nullptr) {
-      erased = eraseMovablePoints(map_, *keyframe, result.labels, movable_point_erode_px_);
-    }
     std::lock_guard state(state_mutex_);
-    ++stats_.keyframes_segmented;
-    stats_.movable_points_erased += erased;
     pending_masks_.push_back(std::move(mask));
   }
   publishSlice(nullptr);
 }
 
 void EdgeMapSession::setNmsThreshold(float nm) {
-  if (segmentation_) segmentation_->setNmsThreshold(nm);
+  backend_->setNmsThreshold(nm);
 }
 
 void EdgeMapSession::finish() {
-  if (segmentation_) segmentation_->waitUntilIdle();
-  mapper_->waitUntilIdle();
-  if (loop_closer_) loop_closer_->waitUntilIdle();
+  backend_->waitUntilIdle();
 }
 
 std::optional<std::string> EdgeMapSession::failure() const {
-  if (auto cause = mapper_->failure()) return cause;
-  if (loop_closer_) {
-    if (auto cause = loop_closer_->failure()) return cause;
-  }
-  if (segmentation_) return segmentation_->failure();
-  return std::nullopt;
+  return backend_->failure();
 }
 
 EdgeMapSessionStats EdgeMapSession::stats() const {
+  const MappingBackendCounters backend = backend_->counters();
   std::lock_guard state(state_mutex_);
-  return stats_;
+  EdgeMapSessionStats out = stats_;
+  out.keyframes_segmented = backend.keyframes_segmented;
+  out.movable_points_erased = backend.movable_points_erased;
+  return out;
 }
 
 }  // namespace edgeslam

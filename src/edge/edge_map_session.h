@@ -10,9 +10,7 @@
 #include <unordered_map>
 
 #include "edge/client_map_window.h"
-#include "edge/keyframe_segmentation.h"
-#include "edge/local_mapper.h"
-#include "edge/loop_closer.h"
+#include "edge/mapping_backend.h"
 #include "geometry/camera.h"
 #include "map/map.h"
 #include "map/map_change_observer.h"
@@ -21,21 +19,18 @@
 
 namespace edgeslam {
 
+// An edge session's back end by default: as local mode's, but with a segmenter, mapping and loop
+// closing run at least nice 10. On the edge's one core a late mask costs the client more than a
+// late map point: 7-Scenes seed 11, 5 edge runs each, segmentation 137-156 ms instead of 201-252
+// and the transferred-mask IoU 0.42-0.61 instead of 0.00-0.48, ATE no worse.
+MappingBackendOptions edgeSessionBackendOptions();
+
 struct EdgeMapSessionOptions {
-  LocalMapperOptions mapper;
-  bool threaded = true;  // false: map each keyframe inside onKeyFrame (deterministic tests)
-  std::shared_ptr<const Vocabulary> vocabulary;
-  bool loop_closing = true;  // with a vocabulary
-  // Semantic culling: keyframes uploaded with an image are segmented on a thread of their own by
-  // this segmenter (one per session); nullptr = no segmentation.
-  std::shared_ptr<Segmenter> segmenter;
-  // With a segmenter, mapping and loop closing run at least this much nicer than segmentation.
-  // On the edge's one core a late mask costs the client more than a late map point: 7-Scenes
-  // seed 11, 5 edge runs each, segmentation 137-156 ms instead of 201-252 and the transferred-
-  // mask IoU 0.42-0.61 instead of 0.00-0.48, ATE no worse.
-  int mapping_nice_when_segmenting = 10;
+  // Mapping, loop closing and, with backend.segmenter, segmentation of keyframes uploaded with an
+  // image (one segmenter per session). backend.threaded = false maps each keyframe inside
+  // onKeyFrame (deterministic tests).
+  MappingBackendOptions backend = edgeSessionBackendOptions();
   int mask_downscale = 4;  // the label image travels at 1/this of the camera's resolution
-  int movable_point_erode_px = 2;
   // The client's bounded map (window.keyframes = 0: it replicates the whole global map).
   ClientMapWindowOptions window;
   // Fills the empty global map before the session's threads start (a stored map resumed after a
@@ -97,9 +92,9 @@ class EdgeMapSession {
   // The keyframes the client holds (lock the map's update mutex while reading).
   const ClientMapWindow& clientWindow() const { return window_; }
   // nullptr without a vocabulary or with loop closing off.
-  const LoopCloser* loopCloser() const { return loop_closer_.get(); }
+  const LoopCloser* loopCloser() const { return backend_->loopCloser(); }
   // nullptr without segmentation.
-  const KeyFrameSegmentationWorker* segmentation() const { return segmentation_.get(); }
+  const KeyFrameSegmentationWorker* segmentation() const { return backend_->segmentation(); }
   // Box NMS threshold of the segmenter (paper Table I's nm), from the next keyframe on.
   void setNmsThreshold(float nm);
   // Told every change of the global map (uploads applied too) and every mask; set before the
@@ -116,13 +111,8 @@ class EdgeMapSession {
   PinholeCamera camera_;
   Map map_;
   MapChangeObserver* observer_ = nullptr;
-  std::unique_ptr<LocalMapper> mapper_;
-  std::unique_ptr<LoopCloser> loop_closer_;
-  std::unique_ptr<KeyFrameSegmentationWorker> segmentation_;
   int mask_downscale_;
-  int movable_point_erode_px_;
   Publish publish_;
-  bool threaded_;
   ClientMapWindow window_;                 // guarded by the map's update mutex
   KeyFrameId window_centre_ = kInvalidId;  // the last keyframe mapped
 
@@ -135,6 +125,9 @@ class EdgeMapSession {
   EdgeMapSessionStats stats_;
   std::size_t loops_published_ = 0;
   std::vector<MaskRecord> pending_masks_;
+
+  // Last: its threads stop (in stop()) before the state above goes.
+  std::unique_ptr<MappingBackend> backend_;
 };
 
 }  // namespace edgeslam

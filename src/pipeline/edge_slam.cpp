@@ -8,6 +8,7 @@
 #include <thread>
 #include <unordered_set>
 
+#include "client/frame_rate_scaling.h"
 #include "client/slice_applier.h"
 #include "semantic/label_encoding.h"
 
@@ -152,12 +153,8 @@ void EdgeSlam::afterFrame() {
 }
 
 void EdgeSlam::applyConfiguration(const KeyframeConfig& config) {
-  // Table I counts frames of a 30 fps camera (as defaultSlamOptions does).
-  const double fps = camera_.intrinsics().fps;
-  const double rate = fps > 0 ? std::min(1.0, fps / 30.0) : 1.0;
   KeyFrameParameters& kf = tracker_->keyframeParameters();
-  kf.fmin = rate < 0.5 ? 0 : static_cast<int>(std::lround(config.fmin * rate));
-  kf.fmax = std::max(1, static_cast<int>(std::lround(config.fmax * rate)));
+  setKeyFrameGaps(kf, config.fmin, config.fmax, camera_.intrinsics().fps);
   kf.alpha = config.alpha;
   kf.beta = config.beta;
   extractor_.setNumLevels(config.pyramid_levels);

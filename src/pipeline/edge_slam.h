@@ -14,29 +14,6 @@
 
 namespace edgeslam {
 
-// The client's own map (bounded or not): what it holds now and the most it held.
-struct ClientMapSize {
-  std::size_t keyframes = 0;  // held: with features and points (not evicted)
-  std::size_t points = 0;
-  std::size_t max_keyframes = 0;
-  std::size_t max_points = 0;
-  std::size_t keyframes_evicted = 0;  // evictions applied over the run
-  std::size_t keyframes_entered = 0;  // keyframes sent back into the window
-};
-
-// What full resyncs (a reconnection after the edge lost its session) did to the client's
-// keyframes: each one the client made is on the edge, re-sent, or lost for a reason counted here.
-struct ResyncCounters {
-  std::uint64_t full_resyncs = 0;      // slices with full_resync applied
-  std::uint64_t keyframes_resent = 0;  // the edge lacked them: uploaded again
-  // The edge lacked them and the client no longer had their features (evicted from its bounded
-  // map before the edge stored them): lost.
-  std::uint64_t keyframes_lost_evicted = 0;
-  // This client's keyframes the edge erased (culled as redundant, on a revisit say): neither in
-  // the edge map nor lost.
-  std::uint64_t keyframes_culled_by_edge = 0;
-};
-
 class EdgeSlam : public TrackingSlam {
  public:
   // With `adaptation` and a networked link, a probing loop retunes the keyframe rules and the
@@ -50,7 +27,7 @@ class EdgeSlam : public TrackingSlam {
   SlamCounters counters() const override;
   LinkTraffic linkTraffic() const override;
   // nullptr without adaptation.
-  const AdaptationLoop* adaptation() const { return adaptation_.get(); }
+  const AdaptationLoop* adaptation() const override { return adaptation_.get(); }
   const char* modeName() const override { return "edge"; }
   // The global map on the edge as the last slice reported it (the client's own map until then;
   // with a bounded client map the client holds only a part of it).
@@ -60,6 +37,10 @@ class EdgeSlam : public TrackingSlam {
   ResyncCounters resyncCounters() const;
   // Points the client triangulated itself (monocular); read once the run is over.
   const KeyFrameTriangulationStats& clientTriangulation() const;
+  // Read once the run is over.
+  std::optional<SplitClientReport> splitClientReport() const override {
+    return SplitClientReport{clientMapSize(), resyncCounters(), clientTriangulation()};
+  }
 
   double finish_timeout_s = 30.0;
 

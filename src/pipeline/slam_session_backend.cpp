@@ -113,8 +113,8 @@ void SlamSessionBackend::publish(MapSlice slice) {
 void SlamSessionBackend::makeMapping(std::optional<StoredSession> resumed) {
   std::lock_guard view_lock(view_mutex_);
   EdgeMapSessionOptions mapping = options_.mapping;
-  mapping.mapper.observe_recent_points = true;
-  mapping.segmenter = segmenter_;
+  mapping.backend.mapper.observe_recent_points = true;
+  mapping.backend.segmenter = segmenter_;
   // The client bounds its map: the window follows its setting.
   mapping.window.keyframes =
       static_cast<std::size_t>(std::max(0, config_.settings.client_map_keyframes));
@@ -127,11 +127,13 @@ void SlamSessionBackend::makeMapping(std::optional<StoredSession> resumed) {
       Stopwatch timer;
       loadStoredSession(*resumed, map);
       // Bags of words stored with the keyframes spare computing them again (~1.8 ms each).
-      const std::shared_ptr<const Vocabulary>& vocabulary =
-          mapping.mapper.vocabulary ? mapping.mapper.vocabulary : mapping.vocabulary;
+      const std::shared_ptr<const Vocabulary>& vocabulary = mapping.backend.mapper.vocabulary
+                                                                ? mapping.backend.mapper.vocabulary
+                                                                : mapping.backend.vocabulary;
       if (vocabulary != nullptr && !vocabulary->empty()) {
-        AttachedPlaces places = attachStoredPlaces(
-            *resumed, map, *vocabulary, vocabulary->checksum(), mapping.mapper.direct_index_depth);
+        AttachedPlaces places =
+            attachStoredPlaces(*resumed, map, *vocabulary, vocabulary->checksum(),
+                               mapping.backend.mapper.direct_index_depth);
         places_attached = places.attached;
         places_missing = std::move(places.missing);
       }
@@ -226,7 +228,7 @@ std::optional<OffloadResult> SlamSessionBackend::onFrame(OffloadFrame frame) {
     slam_options.orb.num_levels = config_.settings.pyramid_levels;
     slam_options.orb.scale_factor = config_.settings.scale_factor;
     slam_options.semantic = segmenter_ != nullptr;
-    slam_options.segmenter = segmenter_;
+    slam_options.backend.segmenter = segmenter_;
     // Each frame's pose goes back as it is tracked; nothing would carry an end-of-session
     // refinement to the client.
     slam_options.refine_intrinsics = false;

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "client/frame_rate_scaling.h"
+
 namespace edgeslam {
 
 SlamOptions defaultSlamOptions(const PinholeCamera& camera, Sensor sensor) {
@@ -11,18 +13,10 @@ SlamOptions defaultSlamOptions(const PinholeCamera& camera, Sensor sensor) {
   options.orb.num_features = camera.width() * camera.height() > 640 * 480 * 1.2 ? 2000 : 1000;
   options.tracker.sensor = sensor;
   // No network between tracking and mapping: N = 0, below paper Table I's first row (0, 10] ms,
-  // whose values we take. The table counts frames of a 30 fps camera, so the counts shrink with a
-  // slower camera; below 15 fps rule 1 is dropped altogether: consecutive frames are then already
-  // far apart (KITTI at 10 fps drives ~1 m per frame) and a minimum gap starves monocular tracking
-  // (KITTI 07: ATE 39 cm with fmin 3, 22-26 cm with fmin 0; 7-Scenes at 30 fps is best with fmin
-  // 10).
-  const double rate =
-      camera.intrinsics().fps > 0 ? std::min(1.0, camera.intrinsics().fps / 30.0) : 1.0;
-  options.tracker.keyframes.fmin = rate < 0.5 ? 0 : static_cast<int>(std::lround(10 * rate));
-  options.tracker.keyframes.fmax = std::max(1, static_cast<int>(std::lround(40 * rate)));
+  // whose values we take.
+  setKeyFrameGaps(options.tracker.keyframes, 10, 40, camera.intrinsics().fps);
   options.tracker.keyframes.alpha = 0.3;
   options.tracker.keyframes.beta = 0.9;
-  options.mapper.monocular = sensor == Sensor::kMonocular;
   // Without depth a focal change trades against the map's shape, so a monocular map's own focal
   // estimate is trusted less: on 7-Scenes the monocular map asked for -5.8 % (585 -> 551-558) and
   // its keyframes got worse (ATE 4.23 -> 4.78 cm), while KITTI's -1.1 % takes its turn drift out.
@@ -35,17 +29,14 @@ TrackingSlam::TrackingSlam(const PinholeCamera& camera, SlamOptions options,
                            std::uint8_t map_id_origin)
     : camera_(camera), options_(std::move(options)), extractor_(options_.orb), map_(map_id_origin) {
   options_.tracker.sensor = options_.sensor;
-  options_.mapper.monocular = options_.sensor == Sensor::kMonocular;
   if (options_.semantic) {
     semantic_filter_ = std::make_unique<SemanticFrameFilter>(camera_, options_.semantic_filter);
     validate(options_.segmentation_refresh);
     const double fps = camera_.intrinsics().fps;
-    const double rate = fps > 0 ? std::min(1.0, fps / 30.0) : 1.0;
-    const auto scaled = [rate](int frames) {
-      return frames <= 0 ? 0 : std::max(1, static_cast<int>(std::lround(frames * rate)));
-    };
-    options_.segmentation_refresh.min_frames = scaled(options_.segmentation_refresh.min_frames);
-    options_.segmentation_refresh.max_frames = scaled(options_.segmentation_refresh.max_frames);
+    options_.segmentation_refresh.min_frames =
+        framesAtCameraRate(options_.segmentation_refresh.min_frames, fps);
+    options_.segmentation_refresh.max_frames =
+        framesAtCameraRate(options_.segmentation_refresh.max_frames, fps);
     options_.tracker.keyframes.segmentation_refresh =
         segmentationRefreshFrames(options_.segmentation_refresh, std::nullopt);
   }

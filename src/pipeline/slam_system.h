@@ -12,19 +12,21 @@
 #include "client/segmentation_refresh.h"
 #include "client/semantic_frame_filter.h"
 #include "client/tracker.h"
-#include "edge/local_mapper.h"
-#include "edge/loop_closer.h"
+#include "edge/mapping_backend.h"
 #include "features/frame_features_builder.h"
 #include "features/orb_extractor.h"
 #include "io/trajectory.h"
 #include "map/map.h"
 #include "optimize/map_optimization.h"
 #include "pipeline/paced_keyframe_sink.h"
+#include "pipeline/split_client_report.h"
 #include "place/vocabulary.h"
 #include "semantic/segmenter.h"
 #include "util/timing_stats.h"
 
 namespace edgeslam {
+
+class AdaptationLoop;
 
 struct SlamOptions {
   Sensor sensor = Sensor::kMonocular;
@@ -33,31 +35,27 @@ struct SlamOptions {
   // Edge mode, monocular: tracking triangulates new points at each keyframe (sets
   // tracker.triangulate_at_keyframes) instead of waiting for the edge's; local mode ignores it.
   bool client_triangulation = true;
-  LocalMapperOptions mapper;
   DepthOptions depth;
-  bool threaded_mapping = true;  // local mode, false: map each keyframe before the next frame
-  // Local mode: nice increment of the mapping and loop-closing threads, so that on a shared core
-  // a frame is tracked before the background work (util/thread_priority.h). Worth it when frames
-  // come at a camera's pace; with frames fed back to back the mapper would fall behind.
-  int background_nice = 0;
+  // The mapping back end (edge/mapping_backend.h). Local mode runs it in-process (its sensor is
+  // `sensor`); edge mode's run gives its mapper, vocabulary and loop-closing options to the edge
+  // session, which runs the same back end. Loop closing needs a vocabulary. Local mode:
+  // backend.threaded = false maps each keyframe before the next frame; backend.thread_nice lowers
+  // mapping and loop closing so that, on a shared core, a frame is tracked before the background
+  // work (util/thread_priority.h), worth it when frames come at a camera's pace (with frames fed
+  // back to back the mapper would fall behind); backend.segmenter segments keyframes when
+  // `semantic` is on.
+  MappingBackendOptions backend;
   // Frames fed back to back (`--fast`): tracking hands over a keyframe only once the back end (the
   // local mapper and segmentation, or the edge) has finished the previous one, so the map does not
   // depend on the machine's speed (pipeline/paced_keyframe_sink.h).
   bool wait_for_backend = false;
-  // Loop closing runs where the global map is mapped (local mode: in-process; edge mode: on the
-  // edge) when a vocabulary is given and it is switched on.
-  std::shared_ptr<const Vocabulary> vocabulary;
-  bool loop_closing = true;
-  // Scale fixing follows `sensor` and threading `threaded_mapping`; the rest is used as is.
-  LoopCloserOptions loop_closer;
-  // Semantic culling (paper Sec. IV-C): keyframes are segmented (local mode: by `segmenter`, on a
-  // thread of its own; edge mode: on the edge, from the image sent with the upload) and each
-  // frame's features on the movable objects, found by transferring the latest keyframe mask, are
-  // culled before tracking.
+  // Semantic culling (paper Sec. IV-C): keyframes are segmented (local mode: by
+  // backend.segmenter, on a thread of its own; edge mode: on the edge, from the image sent with
+  // the upload) and each frame's features on the movable objects, found by transferring the
+  // latest keyframe mask, are culled before tracking.
   bool semantic = false;
   SemanticFilterOptions semantic_filter;
-  std::shared_ptr<Segmenter> segmenter;  // local mode
-  int keyframe_image_reduce = 2;         // keyframes are segmented at 1/this of full size
+  int keyframe_image_reduce = 2;  // keyframes are segmented at 1/this of full size
   // With semantic culling: how many frames (of a 30 fps camera) at most between keyframes, so
   // that people walking into view are segmented soon; the interval follows the masks' delay
   // (client/segmentation_refresh.h, KeyFrameParameters::segmentation_refresh).
@@ -181,6 +179,12 @@ class SlamSystem {
   // track (offload).
   virtual const SemanticFrame* lastSemanticFrame() const { return nullptr; }
   virtual ClientStageTimes lastFrameStages() const { return {}; }
+
+  // What a mode alone has; absent elsewhere. The loop that retunes the keyframe rules to the link
+  // (edge mode with adaptation):
+  virtual const AdaptationLoop* adaptation() const { return nullptr; }
+  // The client's side of the split (edge mode):
+  virtual std::optional<SplitClientReport> splitClientReport() const { return std::nullopt; }
 };
 
 // Modes that track on the client against the client's map: feature extraction and tracking on the

@@ -11,6 +11,8 @@
 #include "eval/association.h"
 #include "eval/ate.h"
 #include "io/dataset.h"
+#include "pipeline/edge_slam.h"
+#include "pipeline/in_process_edge_link.h"
 #include "pipeline/local_slam.h"
 #include "place/vocabulary_training.h"
 #include "support/shared_data.h"
@@ -62,18 +64,25 @@ struct RunOutcome {
   LoopCloserStats stats;
 };
 
+MappingBackendOptions backendOptions(bool loop_closing, std::size_t connected_older_than_frames,
+                                     bool threaded) {
+  MappingBackendOptions backend;
+  backend.threaded = threaded;  // false: deterministic
+  backend.vocabulary = testVocabulary();
+  backend.loop_closing = loop_closing;
+  backend.loop_closer.detector.connected_older_than_frames = connected_older_than_frames;
+  // Revisit culling drops a new keyframe that an older one covers from the same viewpoint, with
+  // shared points: exactly the connected revisits these tests turn into loops to exercise the
+  // loop closer (the normal rule ignores connected keyframes, so it loses no real loop).
+  backend.mapper.cull_revisits = connected_older_than_frames == 0;
+  return backend;
+}
+
 RunOutcome run(const PinholeCamera& camera, const std::vector<DatasetFrame>& frames, Sensor sensor,
                bool loop_closing, std::size_t connected_older_than_frames = 0,
                bool threaded = false) {
   SlamOptions options = defaultSlamOptions(camera, sensor);
-  options.threaded_mapping = threaded;  // false: deterministic
-  options.vocabulary = testVocabulary();
-  options.loop_closing = loop_closing;
-  options.loop_closer.detector.connected_older_than_frames = connected_older_than_frames;
-  // Revisit culling drops a new keyframe that an older one covers from the same viewpoint, with
-  // shared points: exactly the connected revisits these tests turn into loops to exercise the
-  // loop closer (the normal rule ignores connected keyframes, so it loses no real loop).
-  options.mapper.cull_revisits = connected_older_than_frames == 0;
+  options.backend = backendOptions(loop_closing, connected_older_than_frames, threaded);
   LocalSlam slam(camera, options);
   Trajectory ground_truth;
   RunOutcome out;
@@ -163,6 +172,40 @@ TEST(LoopClosing, ThreadedThereAndBackCorrectsWithoutStalling) {
   EXPECT_GE(r.tracked, sequence.frames.size() * 85 / 100);
   EXPECT_EQ(r.stats.global_ba_applied + r.stats.global_ba_cancelled, r.stats.global_ba_started);
   EXPECT_LT(r.ate_final_m, 0.04);
+}
+
+// One back end for both modes: the options that make local mode close the there-and-back loop
+// make an edge session close it too (the edge used to build its loop closer from the sensor's
+// defaults, ignoring them, and found no loop here).
+TEST(LoopClosing, EdgeSessionClosesTheLoopFromTheSameBackendOptions) {
+  EDGESLAM_REQUIRE_SHARED(kSevenScenes);
+  const Sequence sequence = makeSequence(0, 100, 1, true);
+  const MappingBackendOptions backend = backendOptions(true, 100, false);
+  EdgeMapSessionOptions edge_options;
+  edge_options.backend = backend;
+  auto link = std::make_unique<InProcessEdgeLink>(sequence.camera, Sensor::kRgbd, edge_options);
+  InProcessEdgeLink* raw_link = link.get();
+  EdgeSlam edge(sequence.camera, defaultSlamOptions(sequence.camera, Sensor::kRgbd),
+                std::move(link));
+  std::size_t tracked = 0;
+  for (std::size_t k = 0; k < sequence.frames.size(); ++k) {
+    const DatasetFrame& frame = sequence.frames[k];
+    if (edge.process(k, frame.timestamp, frame.gray, frame.depth).state == TrackingState::kOk) {
+      ++tracked;
+    }
+    raw_link->flush();
+  }
+  edge.finish();
+  const LoopCloser* loop_closer = raw_link->session().loopCloser();
+  ASSERT_NE(loop_closer, nullptr);
+  std::printf("rgbd edge: %zu tracked, %zu loops on the edge, %llu reported to the client\n",
+              tracked, loop_closer->loops(),
+              static_cast<unsigned long long>(edge.counters().loops));
+  EXPECT_GE(tracked, sequence.frames.size() * 85 / 100);
+  EXPECT_GE(loop_closer->loops(), 1u);
+  EXPECT_EQ(edge.counters().loops, loop_closer->loops());
+  const RunOutcome local = run(sequence.camera, sequence.frames, Sensor::kRgbd, true, 100);
+  EXPECT_GE(local.loops, 1u);
 }
 
 INSTANTIATE_TEST_SUITE_P(Sensors, ThereAndBack,

@@ -154,7 +154,7 @@ TEST(OmittedDescriptors, EdgeSessionFillsUploadedKeyFrameFromItsPoints) {
             32u * known.size() - 2u);
 
   EdgeMapSessionOptions options;
-  options.threaded = false;  // mapping runs inside onKeyFrame
+  options.backend.threaded = false;  // mapping runs inside onKeyFrame
   EdgeMapSession session(scene.camera(), Sensor::kRgbd, options, [](MapSlice) {});
   session.onKeyFrame(throughTheWire(first));
 

@@ -47,7 +47,7 @@ int niceOfMappingThread(std::shared_ptr<Segmenter> segmenter) {
   for (MapPoint* p : keyframe->goodPoints()) upload.new_points.push_back(mapPointRecord(*p));
 
   EdgeMapSessionOptions options;
-  options.segmenter = std::move(segmenter);
+  options.backend.segmenter = std::move(segmenter);
   std::atomic<int> mapping_nice{-100};
   {
     EdgeMapSession session(scene.camera(), Sensor::kRgbd, options, [&](MapSlice slice) {
@@ -64,7 +64,8 @@ TEST(EdgeSegmentationPriority, MappingYieldsToSegmentationOnlyWhenTheSessionSegm
   const int without = niceOfMappingThread(nullptr);
   const int with = niceOfMappingThread(std::make_shared<NothingSegmenter>());
   EXPECT_EQ(without, own);
-  const int expected = std::min(19, own + EdgeMapSessionOptions{}.mapping_nice_when_segmenting);
+  const int expected =
+      std::min(19, own + EdgeMapSessionOptions{}.backend.thread_nice_when_segmenting);
   EXPECT_EQ(with, expected);
 }
 

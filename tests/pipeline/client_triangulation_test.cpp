@@ -74,9 +74,9 @@ EdgeRun runKitti(std::size_t frames, std::size_t lag, bool client_triangulation)
   options.tracker.vocabulary = kittiVocabulary();
   options.client_triangulation = client_triangulation;
   EdgeMapSessionOptions edge_options;
-  edge_options.threaded = false;
-  edge_options.vocabulary = kittiVocabulary();
-  edge_options.loop_closing = false;
+  edge_options.backend.threaded = false;
+  edge_options.backend.vocabulary = kittiVocabulary();
+  edge_options.backend.loop_closing = false;
   auto link = std::make_unique<LaggingEdgeLink>(camera, edge_options);
   EdgeRun run;
   run.link = link.get();

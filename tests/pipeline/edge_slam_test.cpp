@@ -20,7 +20,7 @@ TEST(EdgeSlam, ClientMapReplicatesTheEdgeMapOnKitti) {
   const PinholeCamera& camera = reader->camera();
   SlamOptions options = defaultSlamOptions(camera, Sensor::kMonocular);
   EdgeMapSessionOptions edge_options;
-  edge_options.threaded = false;
+  edge_options.backend.threaded = false;
   auto link = std::make_unique<InProcessEdgeLink>(camera, Sensor::kMonocular, edge_options);
   InProcessEdgeLink* raw_link = link.get();
   EdgeSlam slam(camera, options, std::move(link));
@@ -66,7 +66,7 @@ TEST(EdgeSlam, BoundedClientMapHoldsTheEdgeWindowOnKitti) {
   const PinholeCamera& camera = reader->camera();
   SlamOptions options = defaultSlamOptions(camera, Sensor::kMonocular);
   EdgeMapSessionOptions edge_options;
-  edge_options.threaded = false;
+  edge_options.backend.threaded = false;
   edge_options.window.keyframes = 6;
   auto link = std::make_unique<InProcessEdgeLink>(camera, Sensor::kMonocular, edge_options);
   InProcessEdgeLink* raw_link = link.get();
@@ -82,6 +82,13 @@ TEST(EdgeSlam, BoundedClientMapHoldsTheEdgeWindowOnKitti) {
   slam.finish();
   EXPECT_GE(tracked, 35u);
   const ClientMapSize size = slam.clientMapSize();
+  // What the run command reads, through the mode-neutral interface.
+  const SlamSystem& system = slam;
+  const std::optional<SplitClientReport> report = system.splitClientReport();
+  ASSERT_TRUE(report.has_value());
+  EXPECT_EQ(report->client_map.keyframes, size.keyframes);
+  EXPECT_EQ(report->client_map.keyframes_evicted, size.keyframes_evicted);
+  EXPECT_EQ(system.adaptation(), nullptr);  // an in-process link does not adapt
   EdgeMapSession& session = raw_link->session();
   Map& edge = session.map();
   std::lock_guard edge_lock(edge.updateMutex());

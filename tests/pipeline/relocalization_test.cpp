@@ -43,7 +43,7 @@ struct KidnapOutcome {
 KidnapOutcome kidnap(Sensor sensor, std::size_t return_at, int blank_frames = 20) {
   auto reader = openDataset(test::sharedPath(kSequence));
   SlamOptions options = defaultSlamOptions(reader->camera(), sensor);
-  options.threaded_mapping = false;
+  options.backend.threaded = false;
   options.tracker.vocabulary = smallVocabulary(*reader);
   LocalSlam slam(reader->camera(), options);
 
