@@ -3,8 +3,10 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <memory>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -39,20 +41,10 @@ void createPointRecord(Map& map, const MapPointRecord& record,
                          record.max_distance);
 }
 
-}  // namespace
-
-void loadStoredSession(const StoredSession& session, Map& map) {
-  // The keyframes' features (copies of the records, keypoint grids) are independent of each other
-  // and of the map: built on every core first, then filed into the map in order.
-  Stopwatch timer;
-  std::vector<std::shared_ptr<FrameFeatures>> features(session.keyframes.size());
-  try {
-    parallelFor(session.keyframes.size(), hardwareThreads(), [&](std::size_t i, int) {
-      features[i] = featuresFromRecord(session.keyframes[i].features, session.info.camera);
-    });
-  } catch (const std::invalid_argument& e) {
-    throw StoreError(std::string("stored session does not load: ") + e.what());
-  }
+// Files the keyframes (with `features`, one per record) and the points into `map`, then links
+// the covisibility graph.
+void fillMap(const StoredSession& session, std::vector<std::shared_ptr<FrameFeatures>>& features,
+             Map& map, const Stopwatch& timer) {
   const double features_ms = timer.elapsedMs();
   std::lock_guard lock(map.updateMutex());
   // Into an empty map (a server resuming, `map info --load`) points are created without looking
@@ -94,6 +86,37 @@ void loadStoredSession(const StoredSession& session, Map& map) {
     map.setChangeRecording(true);
     throw StoreError(std::string("stored session does not load: ") + e.what());
   }
+}
+
+template <typename Session>
+void loadSession(Session& session, Map& map) {
+  // The keyframes' features (the records' arrays, keypoint grids) are independent of each other
+  // and of the map: built on every core first, then filed into the map in order.
+  Stopwatch timer;
+  std::vector<std::shared_ptr<FrameFeatures>> features(session.keyframes.size());
+  try {
+    parallelFor(session.keyframes.size(), hardwareThreads(), [&](std::size_t i, int) {
+      if constexpr (std::is_const_v<Session>) {
+        features[i] = featuresFromRecord(session.keyframes[i].features, session.info.camera);
+      } else {
+        features[i] =
+            featuresFromRecord(std::move(session.keyframes[i].features), session.info.camera);
+      }
+    });
+  } catch (const std::invalid_argument& e) {
+    throw StoreError(std::string("stored session does not load: ") + e.what());
+  }
+  fillMap(session, features, map, timer);
+}
+
+}  // namespace
+
+void loadStoredSession(const StoredSession& session, Map& map) {
+  loadSession(session, map);
+}
+
+void loadStoredSessionTakingFeatures(StoredSession& session, Map& map) {
+  loadSession(session, map);
 }
 
 AttachedPlaces attachStoredPlaces(const StoredSession& session, Map& map,
