@@ -105,7 +105,7 @@ int mapInfo(const MapCommandOptions& o) {
     }
     const double cpu_start_ms = processCpuMs();
     Stopwatch read_timer;
-    const auto stored = store->loadMap(o.name);
+    auto stored = store->loadMap(o.name);
     const double read_ms = read_timer.elapsedMs();
     double rebuild_ms = 0.0, places_ms = 0.0;
     std::size_t keyframes = 0, points = 0, places_stored = 0, places_computed = 0;
@@ -113,10 +113,10 @@ int mapInfo(const MapCommandOptions& o) {
     // Kept until the figures are taken: a server keeps the map it loaded (freeing ~100k points
     // took ~0.5 s of the 1000-keyframe map's figure).
     std::vector<std::unique_ptr<Map>> maps;
-    for (const StoredSession& session : stored->sessions) {
+    for (StoredSession& session : stored->sessions) {
       Map& map = *maps.emplace_back(std::make_unique<Map>());
       Stopwatch rebuild_timer;
-      loadStoredSession(session, map);
+      loadStoredSessionTakingFeatures(session, map);
       rebuild_ms += rebuild_timer.elapsedMs();
       if (vocabulary != nullptr && !vocabulary->empty()) {
         Stopwatch places_timer;

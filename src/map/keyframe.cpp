@@ -1,6 +1,8 @@
 #include "map/keyframe.h"
 
 #include <algorithm>
+#include <bit>
+#include <cstdint>
 #include <utility>
 #include <vector>
 
@@ -102,24 +104,49 @@ int KeyFrame::weight(KeyFrame* other) const {
 }
 
 void KeyFrame::updateConnections() {
-  // Every observer of every point, then counted per keyframe in id order: a sort of one flat
-  // vector instead of an ordered-map insert per observation (a client applies a slice by
-  // re-linking a dozen keyframes of ~2000 points each).
-  std::vector<KeyFrame*> observers;
-  observers.reserve(points_.size() * 4);
+  // The points shared with each other keyframe, counted in a small open-addressing table keyed by
+  // address: no sort of every observer (by id, that sort was half of loading a stored
+  // 1000-keyframe map), no keyframe read per observation. The few keyframes counted are put in id
+  // order after.
+  std::vector<std::pair<KeyFrame*, int>> table(256, {nullptr, 0});
+  std::size_t distinct = 0;
+  const auto slotOf = [&table](const KeyFrame* kf) {
+    // Fibonacci hashing of the address, then linear probing.
+    const std::size_t mask = table.size() - 1;
+    std::size_t slot = (reinterpret_cast<std::uintptr_t>(kf) * 0x9E3779B97F4A7C15ull) >>
+                       (64 - std::countr_zero(table.size()));
+    while (table[slot].first != nullptr && table[slot].first != kf) slot = (slot + 1) & mask;
+    return slot;
+  };
   for (MapPoint* p : points_) {
     if (p == nullptr || p->isBad()) continue;
     for (const auto& [id, obs] : p->observations()) {
-      if (obs.keyframe != this && !obs.keyframe->isBad()) observers.push_back(obs.keyframe);
+      KeyFrame* kf = obs.keyframe;
+      if (kf == this || kf->isBad()) continue;
+      std::size_t slot = slotOf(kf);
+      if (table[slot].first == nullptr) {
+        if (2 * (distinct + 1) > table.size()) {  // at most half full: grow
+          std::vector<std::pair<KeyFrame*, int>> old(table.size() * 2, {nullptr, 0});
+          table.swap(old);
+          for (const auto& entry : old) {
+            if (entry.first != nullptr) table[slotOf(entry.first)] = entry;
+          }
+          slot = slotOf(kf);
+        }
+        table[slot].first = kf;
+        ++distinct;
+      }
+      ++table[slot].second;
     }
   }
-  if (observers.empty()) return;
-  std::sort(observers.begin(), observers.end(), KeyFrameIdLess{});
+  if (distinct == 0) return;
   std::vector<std::pair<KeyFrame*, int>> counts;
-  for (KeyFrame* kf : observers) {
-    if (counts.empty() || counts.back().first != kf) counts.emplace_back(kf, 0);
-    ++counts.back().second;
+  counts.reserve(distinct);
+  for (const auto& entry : table) {
+    if (entry.first != nullptr) counts.push_back(entry);
   }
+  std::sort(counts.begin(), counts.end(),
+            [](const auto& a, const auto& b) { return a.first->id() < b.first->id(); });
 
   // Edges need at least 15 shared points; keep the strongest one anyway so the graph stays
   // connected.
@@ -132,7 +159,7 @@ void KeyFrame::updateConnections() {
       strongest_weight = w;
       strongest = kf;
     }
-    if (w >= kMinWeight) kept[kf] = w;
+    if (w >= kMinWeight) kept.emplace_hint(kept.end(), kf, w);
   }
   if (kept.empty()) kept[strongest] = strongest_weight;
 
@@ -146,7 +173,6 @@ void KeyFrame::updateConnections() {
           kf->ordered_connections_.end());
     }
   }
-  connection_weights_ = kept;
   ordered_connections_.clear();
   for (const auto& [kf, w] : kept) {
     ordered_connections_.emplace_back(w, kf);
@@ -155,10 +181,13 @@ void KeyFrame::updateConnections() {
     theirs.erase(std::remove_if(theirs.begin(), theirs.end(),
                                 [this](const auto& e) { return e.second == this; }),
                  theirs.end());
-    theirs.emplace_back(w, this);
-    std::stable_sort(theirs.begin(), theirs.end(),
-                     [](const auto& a, const auto& b) { return a.first > b.first; });
+    // Still by weight, descending, ties in the order they came: after the last one of weight >= w
+    // (as appending and a stable sort would place it, without the sort).
+    const auto after =
+        std::find_if(theirs.begin(), theirs.end(), [w = w](const auto& e) { return e.first < w; });
+    theirs.emplace(after, w, this);
   }
+  connection_weights_ = std::move(kept);
   std::stable_sort(ordered_connections_.begin(), ordered_connections_.end(),
                    [](const auto& a, const auto& b) { return a.first > b.first; });
 

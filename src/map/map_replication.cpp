@@ -18,8 +18,10 @@ KeyFrameFeaturesRecord featuresRecord(const FrameFeatures& features) {
   return record;
 }
 
-std::shared_ptr<FrameFeatures> featuresFromRecord(const KeyFrameFeaturesRecord& record,
-                                                  const PinholeCamera& camera) {
+namespace {
+
+// Throws std::invalid_argument when the arrays disagree.
+void checkFeaturesRecord(const KeyFrameFeaturesRecord& record) {
   const std::size_t n = record.keypoints.size();
   if (static_cast<std::size_t>(record.descriptors.rows) != n ||
       (n > 0 && (record.descriptors.cols != 32 || record.descriptors.type() != CV_8U))) {
@@ -31,20 +33,48 @@ std::shared_ptr<FrameFeatures> featuresFromRecord(const KeyFrameFeaturesRecord& 
     throw std::invalid_argument(
         "keyframe features: depth / right_u must have one value per keypoint");
   }
+  for (const cv::KeyPoint& kp : record.keypoints) {
+    if (kp.octave < 0 || kp.octave >= record.pyramid_levels) {
+      throw std::invalid_argument("keyframe features: keypoint octave outside the pyramid");
+    }
+  }
+}
+
+std::shared_ptr<FrameFeatures> featuresWithGrid(std::shared_ptr<FrameFeatures> features,
+                                                const KeyFrameFeaturesRecord& record,
+                                                const PinholeCamera& camera) {
+  features->scales = ScaleLevels(record.pyramid_levels, record.scale_factor);
+  features->bf = record.bf;
+  features->grid = FeatureGrid(camera.undistortedBounds(), features->keypoints);
+  return features;
+}
+
+}  // namespace
+
+std::shared_ptr<FrameFeatures> featuresFromRecord(const KeyFrameFeaturesRecord& record,
+                                                  const PinholeCamera& camera) {
+  checkFeaturesRecord(record);
   auto features = std::make_shared<FrameFeatures>();
   features->keypoints = record.keypoints;
   features->descriptors = record.descriptors.clone();
   features->depth = record.depth;
   features->right_u = record.right_u;
-  features->scales = ScaleLevels(record.pyramid_levels, record.scale_factor);
-  for (const cv::KeyPoint& kp : features->keypoints) {
-    if (kp.octave < 0 || kp.octave >= record.pyramid_levels) {
-      throw std::invalid_argument("keyframe features: keypoint octave outside the pyramid");
-    }
-  }
-  features->bf = record.bf;
-  features->grid = FeatureGrid(camera.undistortedBounds(), features->keypoints);
-  return features;
+  return featuresWithGrid(std::move(features), record, camera);
+}
+
+std::shared_ptr<FrameFeatures> featuresFromRecord(KeyFrameFeaturesRecord&& record,
+                                                  const PinholeCamera& camera) {
+  checkFeaturesRecord(record);
+  auto features = std::make_shared<FrameFeatures>();
+  features->keypoints = std::move(record.keypoints);
+  // The record's own matrix (not shared: taken, the record keeps none).
+  features->descriptors = record.descriptors.u != nullptr && record.descriptors.u->refcount == 1
+                              ? record.descriptors
+                              : record.descriptors.clone();
+  record.descriptors.release();
+  features->depth = std::move(record.depth);
+  features->right_u = std::move(record.right_u);
+  return featuresWithGrid(std::move(features), record, camera);
 }
 
 KeyFrameRecord keyFrameRecord(const KeyFrame& keyframe) {

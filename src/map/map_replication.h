@@ -15,6 +15,10 @@ KeyFrameFeaturesRecord featuresRecord(const FrameFeatures& features);
 // Rebuilds scales and the search grid; throws std::invalid_argument when the arrays disagree.
 std::shared_ptr<FrameFeatures> featuresFromRecord(const KeyFrameFeaturesRecord& record,
                                                   const PinholeCamera& camera);
+// The same, taking the keypoints, descriptors and depths out of `record` (left empty) instead of
+// copying them.
+std::shared_ptr<FrameFeatures> featuresFromRecord(KeyFrameFeaturesRecord&& record,
+                                                  const PinholeCamera& camera);
 
 KeyFrameRecord keyFrameRecord(const KeyFrame& keyframe);
 MapPointRecord mapPointRecord(const MapPoint& point);

@@ -125,7 +125,7 @@ void SlamSessionBackend::makeMapping(std::optional<StoredSession> resumed) {
   if (resumed) {
     mapping.preload = [&](Map& map) {
       Stopwatch timer;
-      loadStoredSession(*resumed, map);
+      loadStoredSessionTakingFeatures(*resumed, map);
       // Bags of words stored with the keyframes spare computing them again (~1.8 ms each).
       const std::shared_ptr<const Vocabulary>& vocabulary = mapping.backend.mapper.vocabulary
                                                                 ? mapping.backend.mapper.vocabulary

@@ -5,7 +5,8 @@
 namespace edgeslam {
 
 FeatureVector FeatureVector::fromPairs(std::vector<std::pair<NodeId, int>> pairs) {
-  std::sort(pairs.begin(), pairs.end());
+  // Decoded ones come in order already (a stored map's 1000 direct indices).
+  if (!std::is_sorted(pairs.begin(), pairs.end())) std::sort(pairs.begin(), pairs.end());
   FeatureVector fv;
   fv.features_.reserve(pairs.size());
   for (const auto& [node, feature] : pairs) {

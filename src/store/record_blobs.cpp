@@ -22,13 +22,13 @@ void append(Blob& blob, const T& value) {
 }
 
 template <typename T>
-T read(const Blob& blob, std::size_t offset) {
+T read(BlobView blob, std::size_t offset) {
   T value;
   std::memcpy(&value, blob.data() + offset, sizeof(T));
   return value;
 }
 
-void checkSize(const Blob& blob, std::size_t element, const char* what) {
+void checkSize(BlobView blob, std::size_t element, const char* what) {
   if (blob.size() % element != 0) {
     throw StoreError(std::string("damaged ") + what + " blob (" + std::to_string(blob.size()) +
                      " bytes, not a multiple of " + std::to_string(element) + ")");
@@ -49,7 +49,7 @@ Blob poseBlob(const SE3d& T_cw) {
   return blob;
 }
 
-SE3d poseFromBlob(const Blob& blob) {
+SE3d poseFromBlob(BlobView blob) {
   if (blob.size() != 7 * sizeof(double)) {
     throw StoreError("damaged pose blob (" + std::to_string(blob.size()) + " bytes)");
   }
@@ -72,7 +72,7 @@ Blob keypointsBlob(const std::vector<cv::KeyPoint>& keypoints) {
   return blob;
 }
 
-std::vector<cv::KeyPoint> keypointsFromBlob(const Blob& blob) {
+std::vector<cv::KeyPoint> keypointsFromBlob(BlobView blob) {
   checkSize(blob, kKeyPointBytes, "keypoints");
   std::vector<cv::KeyPoint> keypoints(blob.size() / kKeyPointBytes);
   for (std::size_t i = 0; i < keypoints.size(); ++i) {
@@ -94,7 +94,7 @@ Blob descriptorsBlob(const cv::Mat& descriptors) {
   return Blob(rows.data, rows.data + rows.total() * rows.elemSize());
 }
 
-cv::Mat descriptorsFromBlob(const Blob& blob) {
+cv::Mat descriptorsFromBlob(BlobView blob) {
   checkSize(blob, 32, "descriptors");
   cv::Mat descriptors(static_cast<int>(blob.size() / 32), 32, CV_8U);
   if (!blob.empty()) std::memcpy(descriptors.data, blob.data(), blob.size());
@@ -108,7 +108,7 @@ Blob floatsBlob(const std::vector<float>& values) {
   return blob;
 }
 
-std::vector<float> floatsFromBlob(const Blob& blob) {
+std::vector<float> floatsFromBlob(BlobView blob) {
   checkSize(blob, sizeof(float), "float array");
   std::vector<float> values(blob.size() / sizeof(float));
   if (!blob.empty()) std::memcpy(values.data(), blob.data(), blob.size());
@@ -125,7 +125,7 @@ Blob observationsBlob(const std::vector<PointObservationRecord>& observations) {
   return blob;
 }
 
-std::vector<PointObservationRecord> observationsFromBlob(const Blob& blob) {
+std::vector<PointObservationRecord> observationsFromBlob(BlobView blob) {
   checkSize(blob, kObservationBytes, "observations");
   std::vector<PointObservationRecord> observations(blob.size() / kObservationBytes);
   for (std::size_t i = 0; i < observations.size(); ++i) {
@@ -145,7 +145,7 @@ Blob bowBlob(const BowVector& bow) {
   return blob;
 }
 
-BowVector bowFromBlob(const Blob& blob) {
+BowVector bowFromBlob(BlobView blob) {
   checkSize(blob, 4 + 8, "bag of words");
   BowVector bow;
   bow.entries.reserve(blob.size() / 12);
@@ -172,7 +172,7 @@ Blob featureVectorBlob(const FeatureVector& features) {
   return blob;
 }
 
-FeatureVector featureVectorFromBlob(const Blob& blob) {
+FeatureVector featureVectorFromBlob(BlobView blob) {
   std::vector<std::pair<NodeId, int>> pairs;
   std::size_t offset = 0;
   while (offset < blob.size()) {

@@ -124,6 +124,13 @@ std::vector<std::uint8_t> SqliteStatement::columnBlob(int column) const {
   return {data, data + size};
 }
 
+std::span<const std::uint8_t> SqliteStatement::columnBlobView(int column) const {
+  const auto* data = static_cast<const std::uint8_t*>(sqlite3_column_blob(statement_, column));
+  const int size = sqlite3_column_bytes(statement_, column);
+  if (data == nullptr || size <= 0) return {};
+  return {data, static_cast<std::size_t>(size)};
+}
+
 bool SqliteStatement::columnIsNull(int column) const {
   return sqlite3_column_type(statement_, column) == SQLITE_NULL;
 }

@@ -55,6 +55,8 @@ class SqliteStatement {
   double columnDouble(int column) const;
   std::string columnText(int column) const;
   std::vector<std::uint8_t> columnBlob(int column) const;
+  // The blob where SQLite holds it: valid until the next step() or reset(), no copy.
+  std::span<const std::uint8_t> columnBlobView(int column) const;
   bool columnIsNull(int column) const;
 
  private:

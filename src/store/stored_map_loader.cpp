@@ -3,8 +3,12 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <memory>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
 
 #include "map/map_replication.h"
 #include "place/parallel_for.h"
@@ -13,20 +17,39 @@
 
 namespace edgeslam {
 
-void loadStoredSession(const StoredSession& session, Map& map) {
-  // The keyframes' features (copies of the records, keypoint grids) are independent of each other
-  // and of the map: built on every core first, then filed into the map in order.
-  Stopwatch timer;
-  std::vector<std::shared_ptr<FrameFeatures>> features(session.keyframes.size());
-  try {
-    parallelFor(session.keyframes.size(), hardwareThreads(), [&](std::size_t i, int) {
-      features[i] = featuresFromRecord(session.keyframes[i].features, session.info.camera);
-    });
-  } catch (const std::invalid_argument& e) {
-    throw StoreError(std::string("stored session does not load: ") + e.what());
+namespace {
+
+// A point record into a map that held nothing before the load: what upsertPointRecord does for a
+// point the map does not have, without looking the point up. (Its "made by this side after the
+// sender's newest keyframe" exception cannot arise: every keyframe is the sender's.)
+void createPointRecord(Map& map, const MapPointRecord& record,
+                       std::vector<std::pair<KeyFrame*, std::size_t>>& observers) {
+  observers.clear();
+  for (const PointObservationRecord& obs : record.observations) {
+    KeyFrame* kf = map.keyFrame(obs.keyframe);
+    if (kf != nullptr && obs.keypoint_index < kf->size()) {
+      observers.emplace_back(kf, obs.keypoint_index);
+    }
   }
+  if (observers.empty()) return;
+  KeyFrame* reference = map.keyFrame(record.reference_keyframe);
+  MapPoint* point = map.createMapPoint(
+      record.position, reference != nullptr ? reference : observers[0].first, record.id);
+  for (const auto& [kf, index] : observers) map.addObservation(point, kf, index);
+  const cv::Mat descriptor(1, 32, CV_8U, const_cast<std::uint8_t*>(record.descriptor.data()));
+  map.setPointAppearance(point, record.normal, descriptor, record.min_distance,
+                         record.max_distance);
+}
+
+// Files the keyframes (with `features`, one per record) and the points into `map`, then links
+// the covisibility graph.
+void fillMap(const StoredSession& session, std::vector<std::shared_ptr<FrameFeatures>>& features,
+             Map& map, const Stopwatch& timer) {
   const double features_ms = timer.elapsedMs();
   std::lock_guard lock(map.updateMutex());
+  // Into an empty map (a server resuming, `map info --load`) points are created without looking
+  // for one of the same id first; a map with something in it has its points upserted.
+  const bool fresh = map.keyFrameCount() == 0 && map.pointCount() == 0;
   map.setChangeRecording(false);
   try {
     KeyFrameId newest = kInvalidId;
@@ -41,22 +64,59 @@ void loadStoredSession(const StoredSession& session, Map& map) {
       newest = std::max(newest, record.id);
     }
     const double keyframes_ms = timer.elapsedMs();
+    std::vector<std::pair<KeyFrame*, std::size_t>> observers;
     for (const MapPointRecord& record : session.points) {
-      upsertPointRecord(map, record, newest);
+      // (Point ids are unique in a session: a second record of one id fails to load.)
+      if (fresh) {
+        createPointRecord(map, record, observers);
+      } else {
+        upsertPointRecord(map, record, newest);
+      }
       map.ids().advancePast(record.id);
     }
     const double points_ms = timer.elapsedMs();
     for (KeyFrame* keyframe : map.keyFrames()) map.updateConnections(keyframe);
+    map.setChangeRecording(true);
     spdlog::debug(
         "stored session loaded: features {:.0f} ms, keyframes {:.0f} ms, points {:.0f} ms, "
         "covisibility {:.0f} ms",
         features_ms, keyframes_ms - features_ms, points_ms - keyframes_ms,
         timer.elapsedMs() - points_ms);
-  } catch (const std::invalid_argument& e) {
+  } catch (const std::logic_error& e) {  // records that contradict themselves
     map.setChangeRecording(true);
     throw StoreError(std::string("stored session does not load: ") + e.what());
   }
-  map.setChangeRecording(true);
+}
+
+template <typename Session>
+void loadSession(Session& session, Map& map) {
+  // The keyframes' features (the records' arrays, keypoint grids) are independent of each other
+  // and of the map: built on every core first, then filed into the map in order.
+  Stopwatch timer;
+  std::vector<std::shared_ptr<FrameFeatures>> features(session.keyframes.size());
+  try {
+    parallelFor(session.keyframes.size(), hardwareThreads(), [&](std::size_t i, int) {
+      if constexpr (std::is_const_v<Session>) {
+        features[i] = featuresFromRecord(session.keyframes[i].features, session.info.camera);
+      } else {
+        features[i] =
+            featuresFromRecord(std::move(session.keyframes[i].features), session.info.camera);
+      }
+    });
+  } catch (const std::invalid_argument& e) {
+    throw StoreError(std::string("stored session does not load: ") + e.what());
+  }
+  fillMap(session, features, map, timer);
+}
+
+}  // namespace
+
+void loadStoredSession(const StoredSession& session, Map& map) {
+  loadSession(session, map);
+}
+
+void loadStoredSessionTakingFeatures(StoredSession& session, Map& map) {
+  loadSession(session, map);
 }
 
 AttachedPlaces attachStoredPlaces(const StoredSession& session, Map& map,
