@@ -27,6 +27,7 @@
 #include "pipeline/embedded_edge.h"
 #include "pipeline/grpc_edge_link.h"
 #include "pipeline/local_slam.h"
+#include "pipeline/localization_slam.h"
 #include "pipeline/offload_slam.h"
 #include "pipeline/run_warnings.h"
 #include "place/vocabulary.h"
@@ -184,10 +185,36 @@ SessionConfig sessionConfig(const PinholeCamera& camera, Sensor sensor,
   return config;
 }
 
+// The stored map's latest session with keyframes, read from a store opened read-only.
+std::unique_ptr<SlamSystem> makeLocalizationSlam(const RunOptions& options,
+                                                 const PinholeCamera& camera,
+                                                 const SlamOptions& slam_options) {
+  const auto store = openMapStore(storeDirectory(options.maps), MapStoreAccess::kRead);
+  const std::optional<StoredMap> stored = store->loadMap(options.map_name);
+  if (!stored) {
+    throw std::runtime_error(
+        fmt::format("--localize-only: no map '{}' in {}", options.map_name, store->location()));
+  }
+  const StoredSession* session = latestSessionWithKeyFrames(*stored);
+  if (session == nullptr) {
+    throw std::runtime_error(fmt::format("--localize-only: map '{}' in {} has no keyframes",
+                                         options.map_name, store->location()));
+  }
+  try {
+    return std::make_unique<LocalizationSlam>(camera, slam_options, *session);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(
+        fmt::format("--localize-only in map '{}': {}", options.map_name, e.what()));
+  }
+}
+
 std::unique_ptr<SlamSystem> makeSlamSystem(const RunOptions& options, const std::string& mode,
                                            const PinholeCamera& camera, Sensor sensor,
                                            const SlamOptions& slam_options,
                                            const EdgeEndpoint& edge) {
+  if (mode == "local" && options.localize_only) {
+    return makeLocalizationSlam(options, camera, slam_options);
+  }
   if (mode == "local") return std::make_unique<LocalSlam>(camera, slam_options);
   const SessionConfig config = sessionConfig(camera, sensor, slam_options, options);
   if (mode == "offload") {
@@ -292,6 +319,22 @@ int runPipeline(const RunOptions& given) {
     slam_options.backend.threaded = false;
     cv::setNumThreads(1);
   }
+  if (options.localize_only) {
+    if (mode != "local") {
+      throw CLI::ValidationError("--localize-only",
+                                 "applies to --mode local only so far (the edge does not yet "
+                                 "relocalise a client in a stored map)");
+    }
+    if (options.map_name.empty()) {
+      throw CLI::ValidationError("--localize-only",
+                                 "needs --map NAME: the stored map to localise in");
+    }
+    if (options.semantic) {
+      throw CLI::ValidationError("--localize-only",
+                                 "and --semantic on: masks come from segmented keyframes, and "
+                                 "localisation makes none");
+    }
+  }
   if (options.refine_intrinsics && mode != "local") {
     spdlog::warn("--refine-intrinsics applies to --mode local only; the {} run keeps the camera",
                  mode);
@@ -321,7 +364,8 @@ int runPipeline(const RunOptions& given) {
   spdlog::info("{} ORB features, {} levels; keyframes fmin {} fmax {} alpha {} beta {}",
                slam_options.orb.num_features, slam_options.orb.num_levels, kf.fmin, kf.fmax,
                kf.alpha, kf.beta);
-  if (mode == "local" && !options.maps.empty() && options.maps != "none") {
+  if (mode == "local" && !options.localize_only && !options.maps.empty() &&
+      options.maps != "none") {
     spdlog::warn("--maps: local runs keep no map yet (edge mode does)");
   }
   if (options.map_name.empty() && options.server_address.empty() && mode == "edge") {
@@ -484,7 +528,8 @@ int runPipeline(const RunOptions& given) {
                    .keyframe_depth_ratio = counters.keyframe_depth_ratio,
                    .frames_out_of_order = frame_order.rejected(),
                    .frames_without_map = diagnostics ? diagnostics->frames_without_map : 0,
-                   .map_built = !diagnostics || diagnostics->initialized_at_frame.has_value(),
+                   .map_built = !diagnostics || diagnostics->initialized_at_frame.has_value() ||
+                                options.localize_only,
                    .refusals = diagnostics ? refusalSummary(*diagnostics) : std::string()});
   if (std::string store_warning = storeWarning(store_metrics, slam.keyFrameCount());
       !store_warning.empty()) {
@@ -526,6 +571,7 @@ int runPipeline(const RunOptions& given) {
                             {"wall_s", seconds},
                             {"pacing", options.realtime ? "realtime" : "fast"},
                             {"deterministic", options.deterministic},
+                            {"localize_only", options.localize_only},
                             {"frames_dropped_late", frames_dropped_late},
                             {"frames_skipped_late", frames_skipped_late},
                             {"frames_processed", frame_log.size()},
@@ -551,6 +597,17 @@ int runPipeline(const RunOptions& given) {
   if (diagnostics) {
     metrics["initialization"] = initializationJson(*diagnostics);
     metrics["lost_frames"] = lostFramesJson(*diagnostics);
+  }
+  if (options.localize_only) {
+    // The frame (of this run) at which the first pose in the stored map was found.
+    const auto first = std::find_if(frame_log.begin(), frame_log.end(), [](const auto& entry) {
+      return entry.state == TrackingState::kOk;
+    });
+    metrics["localization"] = {
+        {"map", options.map_name},
+        {"stored_keyframes", slam.keyFrameCount()},
+        {"first_pose_frame",
+         first == frame_log.end() ? nlohmann::json() : nlohmann::json(first->index)}};
   }
   if (counters.features_ms.count > 0) {
     metrics["client_stages_ms"] = {{"features", toJson(counters.features_ms)},
@@ -822,6 +879,9 @@ void addRunOptions(CLI::App* run, const std::shared_ptr<RunOptions>& options) {
                 "Local mode: map each keyframe (and close loops) before the next frame, on one "
                 "thread, so two runs give the same trajectory (for tests and bisecting; slower)")
       ->excludes(realtime);
+  run->add_flag("--localize-only", options->localize_only,
+                "Local mode: localise in the stored map --map (from --maps) and follow it; no "
+                "keyframe is made and the store is opened read-only");
   run->add_option("--out", options->out_dir,
                   "Output folder (trajectories, metrics.json, frames.csv with each frame's times)");
   run->add_option("--viewer", options->viewer_port,

@@ -37,6 +37,7 @@ struct RunOptions {
   bool realtime = false;             // feed at the dataset's rate (default: as fast as possible)
   bool fast = false;                 // explicit request for the default
   bool deterministic = false;        // local: lock-step back end, one thread, identical runs
+  bool localize_only = false;        // local: localise in the stored map --map, change nothing
   std::filesystem::path out_dir;
   std::optional<int> viewer_port;  // serve the web viewer (0 = any free port)
   std::string viewer_host = "127.0.0.1";

@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <stdexcept>
 #include <unordered_map>
 
 #include "geometry/pnp.h"
@@ -57,6 +58,21 @@ void Tracker::remember(KeyFrame* keyframe) {
   if (options_.triangulate_at_keyframes && keyframe->place() == nullptr) {
     keyframe->setPlace(std::move(place));
   }
+}
+
+void Tracker::localizeInMap() {
+  if (!places_) {
+    throw std::invalid_argument("localisation in a stored map needs a vocabulary");
+  }
+  std::lock_guard lock(map_.updateMutex());
+  std::size_t filed = 0;
+  for (KeyFrame* keyframe : map_.keyFrames()) {
+    if (keyframe->isBad() || keyframe->isEvicted()) continue;
+    remember(keyframe);
+    ++filed;
+  }
+  if (filed == 0) throw std::invalid_argument("localisation: the map has no keyframes");
+  state_ = TrackingState::kLost;
 }
 
 void Tracker::onMapWindowChanged(const std::vector<KeyFrameId>& evicted,
@@ -162,7 +178,8 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
         velocity_ = perFrameMotion(*frame.T_cw * last_frame_->T_cw->inverse(),
                                    frame_index - last_frame_->index);
       }
-      const KeyFrameDecision decision = decide(frame, inliers);
+      const KeyFrameDecision decision =
+          options_.localization_only ? KeyFrameDecision::kNo : decide(frame, inliers);
       if (isKeyFrame(decision)) {
         keyframe_decisions_.add(decision);
         new_keyframe = createKeyFrame(frame);
@@ -188,7 +205,8 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
   if (new_keyframe != nullptr && sink_ != nullptr) sink_->insertKeyFrame(new_keyframe);
 
   // A monocular map that is lost within its first few keyframes is not worth keeping.
-  if (state_ == TrackingState::kLost && options_.sensor == Sensor::kMonocular && frames_lost_ > 0) {
+  if (state_ == TrackingState::kLost && options_.sensor == Sensor::kMonocular && frames_lost_ > 0 &&
+      !options_.localization_only) {
     std::size_t keyframes = 0;
     {
       std::lock_guard lock(map_.updateMutex());

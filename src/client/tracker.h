@@ -64,6 +64,9 @@ struct TrackerOptions {
   double min_triangulation_parallax_deg = kDefaultMinTriangulationParallaxDeg;
   // Fill TrackResult::features_on_map / features_new (a viewer draws them; off, nothing is copied).
   bool report_feature_positions = false;
+  // Localisation in a map made earlier (Tracker::localizeInMap): no keyframes are made and the map
+  // is never reset, so tracking changes nothing in it but its points' seen/found counts.
+  bool localization_only = false;
 };
 
 // What triangulating at keyframes did (TrackerOptions::triangulate_at_keyframes).
@@ -82,6 +85,11 @@ class Tracker {
 
   TrackResult track(std::size_t frame_index, double timestamp,
                     std::shared_ptr<const FrameFeatures> features);
+
+  // Localisation only: the map already holds a map made earlier (loaded before the first frame).
+  // Its keyframes go into the relocalisation database and tracking starts lost, so that the first
+  // frames relocalise in it. Needs a vocabulary; throws std::invalid_argument otherwise.
+  void localizeInMap();
 
   TrackingState state() const { return state_; }
   const TrackerOptions& options() const { return options_; }
