@@ -45,6 +45,12 @@ void EdgeKeyFrameSink::sendUpload(KeyFrame* keyframe, bool resend) {
       upload.new_points.push_back(std::move(record));
       uploaded_points_.insert(p->id());
     }
+    // Points the map has erased since cannot be uploaded again: forgotten a few thousand at a time,
+    // so that what a long session remembers follows what its map holds.
+    if (uploaded_points_.size() > 2 * map_.pointCount() + kForgetUploadedPointsEvery) {
+      std::erase_if(uploaded_points_,
+                    [this](MapPointId id) { return map_.mapPoint(id) == nullptr; });
+    }
     upload.segmenter_nms = segmenter_nms_.load();
     if (!resend) {
       upload.map_reset = reset_pending_;

@@ -101,6 +101,7 @@ class EdgeKeyFrameSink : public KeyFrameSink {
   std::atomic<float> segmenter_nms_{0.f};
   std::size_t image_frame_ = 0;
   cv::Mat image_;
+  static constexpr std::size_t kForgetUploadedPointsEvery = 4096;
   std::unordered_set<MapPointId> uploaded_points_;
   std::deque<UploadRecord> recent_uploads_;  // guarded by the map's update mutex
   mutable std::mutex sent_mutex_;
