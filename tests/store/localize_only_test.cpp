@@ -16,11 +16,22 @@
 #include "support/edgeslam_command.h"
 #include "support/fresh_temp_dir.h"
 #include "support/shared_data.h"
+#include "support/small_vocabulary.h"
 
 namespace edgeslam {
 namespace {
 
 constexpr const char* kSequence = "datasets/7scenes-redkitchen-1000";
+
+// Relocalisation needs a vocabulary, and a fresh build has none (`make vocab` trains the default):
+// a small one, trained on other sequences than the one localised in, is written for the runs.
+std::string writeSmallVocabulary(const std::filesystem::path& folder) {
+  std::filesystem::create_directories(folder);
+  const auto path = folder / "small.vocab";
+  test::trainSmallVocabulary({{"datasets/tum-fr2desk-20", 1}, {"datasets/kitti07-160", 8}})
+      .save(path);
+  return path.string();
+}
 
 std::string fileBytes(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
@@ -38,17 +49,19 @@ TEST(LocalizeOnly, FramesOfTheSecondHalfLocaliseInTheStoredMapOfTheWholeRun) {
   const auto store = test::freshTempDir("localize_store");
   const auto mapping_out = test::freshTempDir("localize_mapping");
   const auto localize_out = test::freshTempDir("localize_run");
+  const auto vocab_folder = test::freshTempDir("localize_vocab");
+  const std::string vocab = " --vocab " + writeSmallVocabulary(vocab_folder);
 
-  const auto mapping =
-      test::runEdgeslam("run --dataset " + dataset + " --mode edge --sensor rgbd --maps " +
-                        store.string() + " --map kitchen --out " + mapping_out.string());
+  const auto mapping = test::runEdgeslam(
+      "run --dataset " + dataset + " --mode edge --sensor rgbd --maps " + store.string() +
+      " --map kitchen" + vocab + " --out " + mapping_out.string());
   ASSERT_EQ(mapping.exit_code, 0) << mapping.output;
   const std::string store_before = fileBytes(store / "maps.sqlite");
   ASSERT_FALSE(store_before.empty());
 
   const auto localize = test::runEdgeslam(
       "run --dataset " + dataset + " --frames 500-999 --mode local --sensor rgbd --localize-only" +
-      " --maps " + store.string() + " --map kitchen --out " + localize_out.string());
+      " --maps " + store.string() + " --map kitchen" + vocab + " --out " + localize_out.string());
   ASSERT_EQ(localize.exit_code, 0) << localize.output;
   const auto metrics = readMetrics(localize_out);
   SCOPED_TRACE(metrics.dump());
@@ -84,6 +97,7 @@ TEST(LocalizeOnly, FramesOfTheSecondHalfLocaliseInTheStoredMapOfTheWholeRun) {
   std::filesystem::remove_all(store);
   std::filesystem::remove_all(mapping_out);
   std::filesystem::remove_all(localize_out);
+  std::filesystem::remove_all(vocab_folder);
 }
 
 TEST(LocalizeOnly, MissingStoreWrongModeAndNoMapNameAreClearErrors) {
