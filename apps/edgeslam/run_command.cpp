@@ -38,6 +38,7 @@
 #include "segmenter_option.h"
 #include "semantic_evaluation.h"
 #include "store/store_location.h"
+#include "store/stored_map_loader.h"
 #include "tracking_diagnostics_json.h"
 #include "util/timing_stats.h"
 #include "viz/viewed_session_factory.h"
@@ -190,7 +191,7 @@ std::unique_ptr<SlamSystem> makeLocalizationSlam(const RunOptions& options,
                                                  const PinholeCamera& camera,
                                                  const SlamOptions& slam_options) {
   const auto store = openMapStore(storeDirectory(options.maps), MapStoreAccess::kRead);
-  const std::optional<StoredMap> stored = store->loadMap(options.map_name);
+  std::optional<StoredMap> stored = store->loadMap(options.map_name);
   if (!stored) {
     throw std::runtime_error(
         fmt::format("--localize-only: no map '{}' in {}", options.map_name, store->location()));

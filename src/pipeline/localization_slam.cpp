@@ -56,11 +56,4 @@ SlamCounters LocalizationSlam::counters() const {
   return out;
 }
 
-const StoredSession* latestSessionWithKeyFrames(const StoredMap& map) {
-  for (auto it = map.sessions.rbegin(); it != map.sessions.rend(); ++it) {
-    if (!it->keyframes.empty()) return &*it;
-  }
-  return nullptr;
-}
-
 }  // namespace edgeslam

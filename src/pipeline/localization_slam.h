@@ -23,8 +23,4 @@ class LocalizationSlam : public TrackingSlam {
   std::size_t stored_keyframes_ = 0;
 };
 
-// The session a localisation (or a resumed edge session) uses: the latest one with keyframes;
-// each stored session is in its own frame. nullptr when none has keyframes.
-const StoredSession* latestSessionWithKeyFrames(const StoredMap& map);
-
 }  // namespace edgeslam

@@ -79,20 +79,17 @@ std::optional<StoredSession> SlamSessionBackend::storedSessionToResume() {
     return std::nullopt;
   }
   if (!stored) return std::nullopt;
-  // Each stored session is in its own frame: the latest one with keyframes is resumed.
-  for (auto it = stored->sessions.rbegin(); it != stored->sessions.rend(); ++it) {
-    if (it->keyframes.empty()) continue;
-    if (it->info.sensor != config_.sensor) {
-      spdlog::warn("session {}: map '{}' was made with a {} sensor: not resumed by a {} session",
-                   config_.session_id, config_.map_name, toString(it->info.sensor),
-                   toString(config_.sensor));
-      return std::nullopt;
-    }
-    spdlog::info("session {}: map '{}' read from {} in {:.0f} ms", config_.session_id,
-                 config_.map_name, options_.store->location(), read_timer.elapsedMs());
-    return std::move(*it);
+  StoredSession* latest = latestSessionWithKeyFrames(*stored);
+  if (latest == nullptr) return std::nullopt;
+  if (latest->info.sensor != config_.sensor) {
+    spdlog::warn("session {}: map '{}' was made with a {} sensor: not resumed by a {} session",
+                 config_.session_id, config_.map_name, toString(latest->info.sensor),
+                 toString(config_.sensor));
+    return std::nullopt;
   }
-  return std::nullopt;
+  spdlog::info("session {}: map '{}' read from {} in {:.0f} ms", config_.session_id,
+               config_.map_name, options_.store->location(), read_timer.elapsedMs());
+  return std::move(*latest);
 }
 
 void SlamSessionBackend::publish(MapSlice slice) {

@@ -186,4 +186,11 @@ std::size_t describeKeyFrames(Map& map, const Vocabulary& vocabulary, int direct
   return keyframes.size();
 }
 
+StoredSession* latestSessionWithKeyFrames(StoredMap& map) {
+  for (auto it = map.sessions.rbegin(); it != map.sessions.rend(); ++it) {
+    if (!it->keyframes.empty()) return &*it;
+  }
+  return nullptr;
+}
+
 }  // namespace edgeslam

@@ -14,6 +14,10 @@
 
 namespace edgeslam {
 
+// The session a map is resumed or localised in: the latest one with keyframes (each stored session
+// is in its own frame). nullptr when none has keyframes.
+StoredSession* latestSessionWithKeyFrames(StoredMap& map);
+
 // Into an empty map. Throws StoreError when the records contradict themselves.
 void loadStoredSession(const StoredSession& session, Map& map);
 // The same, moving each keyframe's features out of its record instead of copying them (the
