@@ -22,6 +22,11 @@ Trajectory within(const Trajectory& trajectory, double first, double last) {
   return part;
 }
 
+std::uint64_t heapInUseBytes() {
+  const struct mallinfo2 heap = mallinfo2();
+  return heap.uordblks + heap.hblkhd;
+}
+
 double rmse(const std::vector<double>& errors) {
   if (errors.empty()) return 0.0;
   double sum = 0.0;
@@ -51,6 +56,12 @@ void PassLog::addFrame(std::size_t index, double timestamp, const TrackResult& r
   if (result.state == TrackingState::kLost) ++pass.lost;
   if (result.relocalized) ++pass.relocalized;
   if (result.new_keyframe) ++pass.keyframes_made;
+  const std::size_t in_pass = frames_per_pass_ == 0 ? pass.frames : index % frames_per_pass_;
+  const bool second_half = frames_per_pass_ == 0 || 2 * in_pass >= frames_per_pass_;
+  if (second_half && in_pass % kHeapSampleEvery == 0) {
+    const std::uint64_t heap = heapInUseBytes();
+    if (pass.heap_floor_bytes == 0 || heap < pass.heap_floor_bytes) pass.heap_floor_bytes = heap;
+  }
 }
 
 void PassLog::beforeFrame(std::size_t index, const SlamSystem& slam,
@@ -75,8 +86,10 @@ void PassLog::close(const SlamSystem& slam,
   pass.map_resets = slam.mapResets();
   pass.rss_bytes = residentBytes();
   pass.peak_rss_bytes = peakResidentBytes();
-  const struct mallinfo2 heap = mallinfo2();
-  pass.heap_in_use_bytes = heap.uordblks + heap.hblkhd;
+  pass.heap_in_use_bytes = heapInUseBytes();
+  if (pass.heap_floor_bytes == 0 || pass.heap_in_use_bytes < pass.heap_floor_bytes) {
+    pass.heap_floor_bytes = pass.heap_in_use_bytes;
+  }
   pass.wall_s = wall_s;
   open_ = false;
 }
@@ -105,6 +118,7 @@ nlohmann::json PassLog::json(const Trajectory& ground_truth, const Trajectory& e
                            {"rss_bytes", p.rss_bytes},
                            {"peak_rss_bytes", p.peak_rss_bytes},
                            {"heap_in_use_bytes", p.heap_in_use_bytes},
+                           {"heap_floor_bytes", p.heap_floor_bytes},
                            {"wall_s", p.wall_s}};
     const Trajectory gt = within(ground_truth, p.first_timestamp, p.last_timestamp);
     const Trajectory est = within(estimate, p.first_timestamp, p.last_timestamp);
@@ -135,9 +149,10 @@ void PassLog::print() const {
     const PassRecord& p = passes_[k];
     fmt::print(
         "  pass {:<3}     tracked {}, lost {}, relocalised {}; map {} keyframes, {} points; RSS "
-        "{:.0f} MB (peak {:.0f} MB)\n",
+        "{:.0f} MB (peak {:.0f} MB), heap floor {:.0f} MB\n",
         k + 1, p.tracked, p.lost, p.relocalized, p.map_keyframes, p.map_points,
-        static_cast<double>(p.rss_bytes) / 1e6, static_cast<double>(p.peak_rss_bytes) / 1e6);
+        static_cast<double>(p.rss_bytes) / 1e6, static_cast<double>(p.peak_rss_bytes) / 1e6,
+        static_cast<double>(p.heap_floor_bytes) / 1e6);
   }
 }
 

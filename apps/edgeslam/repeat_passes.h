@@ -40,6 +40,10 @@ struct PassRecord {
   std::uint64_t rss_bytes = 0;
   std::uint64_t peak_rss_bytes = 0;
   std::uint64_t heap_in_use_bytes = 0;  // malloc's allocated bytes (live objects, not free chunks)
+  // The least heap in use sampled over the pass's second half: what the process keeps, without
+  // the work in flight at one instant (a local BA's problem, a slice being built), which swings
+  // the end-of-pass sample by ~15 MB in RGB-D.
+  std::uint64_t heap_floor_bytes = 0;
   double wall_s = 0.0;
 };
 
@@ -69,6 +73,9 @@ class PassLog {
   PassRecord& current(std::size_t index, double timestamp);
   void close(const SlamSystem& slam, const std::function<std::optional<EdgeMapSize>()>& edge_map,
              double wall_s);
+
+  // Every this many frames in a pass's second half (mallinfo2 walks every arena's free lists).
+  static constexpr std::size_t kHeapSampleEvery = 5;
 
   std::size_t frames_per_pass_;
   std::vector<PassRecord> passes_;

@@ -60,11 +60,13 @@ TEST(MapRepeat, ThreePassesGoOnInOneMapThatStaysBounded) {
   }
   // Memory follows what the maps hold, not what they ever held: erased points and keyframes are
   // freed (before, the heap grew with every pass: 66 -> 91 -> 110 MB while the maps stayed the
-  // same size).
-  const double first_heap = passes[0]["heap_in_use_bytes"].get<double>();
-  const double last_heap = passes[2]["heap_in_use_bytes"].get<double>();
+  // same size). Compared on each pass's floor: one end-of-pass sample swings by ~15 MB with the
+  // work in flight (25-40 MB in one run), more than the growth this bounds.
+  const double first_heap = passes[0]["heap_floor_bytes"].get<double>();
+  const double last_heap = passes[2]["heap_floor_bytes"].get<double>();
+  EXPECT_GT(first_heap, 0);
   EXPECT_LE(last_heap, 1.3 * first_heap)
-      << "heap in use: pass 1 " << first_heap / 1e6 << " MB, pass 3 " << last_heap / 1e6 << " MB";
+      << "heap floor: pass 1 " << first_heap / 1e6 << " MB, pass 3 " << last_heap / 1e6 << " MB";
   // The store holds one map of one session, as large as the edge's.
   const auto info = test::runEdgeslam("map info kitchen --json --maps " + store.string(), false);
   ASSERT_EQ(info.exit_code, 0) << info.output;
