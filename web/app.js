@@ -301,6 +301,7 @@ function showMobile(snapshot, first) {
     ['link', s.link || '-'],
     ['adaptation row', s.adaptation_row >= 0 ? s.adaptation_row + 1 : '-'],
   ];
+  if (s.instruction) rows.push(['instruction', s.instruction]);
   showRows(rows);
   addChartSample(s.frame, [s.client_ms, s.e2e_ms ?? null]);
 

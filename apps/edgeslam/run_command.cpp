@@ -33,6 +33,7 @@
 #include "place/vocabulary.h"
 #include "progress_line.h"
 #include "repeat_passes.h"
+#include "route_following.h"
 #include "run_options.h"
 #include "run_viewer.h"
 #include "segmenter_option.h"
@@ -336,6 +337,10 @@ int runPipeline(const RunOptions& given) {
                                  "localisation makes none");
     }
   }
+  if (!options.route.empty() && !options.localize_only) {
+    throw CLI::ValidationError("--route",
+                               "needs --localize-only: a route is followed in a stored map");
+  }
   if (options.refine_intrinsics && mode != "local") {
     spdlog::warn("--refine-intrinsics applies to --mode local only; the {} run keeps the camera",
                  mode);
@@ -379,8 +384,11 @@ int runPipeline(const RunOptions& given) {
       makeSlamSystem(options, mode, reader->camera(), sensor, slam_options, edge);
   SlamSystem& slam = *slam_system;
   const auto viewer_attachment = viewer ? viewer->attach(slam) : nullptr;
-  viz::RunStatus view_status{
-      .frames_total = frame_count, .mode = mode, .sensor = sensor_name, .link = options.link};
+  viz::RunStatus view_status{.frames_total = frame_count,
+                             .mode = mode,
+                             .sensor = sensor_name,
+                             .link = options.link,
+                             .instruction = {}};
   // e2e: from the frame's arrival to its pose. With --realtime a frame arrives at its due time
   // on the camera clock (so reading it and any backlog count); otherwise when it has been read.
   SampleStats client_ms, load_ms, e2e_ms;
@@ -407,6 +415,12 @@ int runPipeline(const RunOptions& given) {
   const auto edge_map_size = [&edge] { return edge.sessionMapSize(); };
   std::optional<PassLog> pass_log;
   if (options.repeat > 1) pass_log.emplace(frames_per_pass);
+  std::optional<RouteFollowing> route;
+  if (!options.route.empty()) {
+    route.emplace(
+        storeDirectory(options.maps), options.map_name, options.route,
+        RouteFollowingOptions{.success_radius_m = options.checkpoint_radius_m, .navigator = {}});
+  }
   std::size_t next_unpaced = 0;
   for (;;) {
     std::size_t i = 0;
@@ -439,6 +453,10 @@ int runPipeline(const RunOptions& given) {
     if (semantic_eval)
       semantic_eval->addFrame(i % frames_per_pass, result, slam.lastSemanticFrame());
     if (pass_log) pass_log->addFrame(i, frame.timestamp, result);
+    if (route) {
+      route->addFrame(i, frame.timestamp,
+                      result.state == TrackingState::kOk ? result.T_cw : std::nullopt);
+    }
     client_ms.add(processing_ms);
     double frame_e2e_ms = processing_ms;
     if (live_camera) frame_e2e_ms = std::max(processing_ms, wall.elapsedMs() - due_ms);
@@ -473,10 +491,10 @@ int runPipeline(const RunOptions& given) {
     const double fps = static_cast<double>(i + 1) / std::max(1e-9, wall.elapsedMs() / 1000.0);
     const std::size_t keyframes = slam.keyFrameCount();
     const std::size_t map_points = slam.mapPointCount();
-    progress.update(
-        fmt::format("frame {}/{}  {:.1f} fps  {}  tracked {}  kf {}  points {}", i + 1, frame_count,
-                    fps, toString(result.state), tracked, keyframes, map_points),
-        i + 1 == frame_count);
+    progress.update(fmt::format("frame {}/{}  {:.1f} fps  {}  tracked {}  kf {}  points {}{}",
+                                i + 1, frame_count, fps, toString(result.state), tracked, keyframes,
+                                map_points, route ? "  " + route->lastText() : std::string()),
+                    i + 1 == frame_count);
     if (viewer) {
       view_status.frame = i + 1;
       view_status.fps = fps;
@@ -487,6 +505,7 @@ int runPipeline(const RunOptions& given) {
       view_status.client_ms = processing_ms;
       view_status.e2e_ms = frame_e2e_ms;
       view_status.adaptation_row = frame_log.back().adaptation_row;
+      if (route) view_status.instruction = route->lastText();
       view_status.uplink_bytes = frame_log.back().uplink_bytes;
       view_status.downlink_bytes = frame_log.back().downlink_bytes;
       const std::optional<SE3d> camera =
@@ -609,6 +628,9 @@ int runPipeline(const RunOptions& given) {
         {"stored_keyframes", slam.keyFrameCount()},
         {"first_pose_frame",
          first == frame_log.end() ? nlohmann::json() : nlohmann::json(first->index)}};
+  }
+  if (route) {
+    metrics["navigation"] = route->json(ground_truth, slam.keyframeTrajectory(), at_time, align);
   }
   if (counters.features_ms.count > 0) {
     metrics["client_stages_ms"] = {{"features", toJson(counters.features_ms)},
@@ -744,6 +766,20 @@ int runPipeline(const RunOptions& given) {
                (*ate)["rmse_m"].get<double>(), (*ate)["pairs"].get<std::size_t>());
   }
   if (pass_log) pass_log->print();
+  if (route) {
+    const nlohmann::json& nav = metrics["navigation"];
+    fmt::print("  route        '{}': {} checkpoints, {} announced reached", options.route,
+               nav["checkpoints"].get<std::size_t>(),
+               nav["reached_by_estimate"].get<std::size_t>());
+    if (nav.contains("success_rate")) {
+      fmt::print(
+          "; success {:.1f} % ({} within {:.2f} m of the truth; announced {:.2f} m from it, "
+          "median)",
+          100.0 * nav["success_rate"].get<double>(), nav["reached"].get<std::size_t>(),
+          nav["success_radius_m"].get<double>(), nav["announced_error_m"]["median"].get<double>());
+    }
+    fmt::print("\n");
+  }
   if (ate_final) {
     fmt::print("  ATE final    rmse {:.4f} m  ({} poses, refined)\n",
                (*ate_final)["rmse_m"].get<double>(), (*ate_final)["pairs"].get<std::size_t>());
@@ -777,6 +813,7 @@ int runPipeline(const RunOptions& given) {
     if (!ground_truth.empty())
       writeTumTrajectory(options.out_dir / "groundtruth.tum", ground_truth);
     writeFrameLog(options.out_dir / "frames.csv", frame_log);
+    if (route) route->writeInstructions(options.out_dir / "instructions.csv");
     std::ofstream out(options.out_dir / "metrics.json");
     out << metrics.dump(2) << "\n";
     spdlog::info("wrote trajectories, frames.csv and metrics.json to {}", options.out_dir.string());
@@ -883,6 +920,15 @@ void addRunOptions(CLI::App* run, const std::shared_ptr<RunOptions>& options) {
   run->add_flag("--localize-only", options->localize_only,
                 "Local mode: localise in the stored map --map (from --maps) and follow it; no "
                 "keyframe is made and the store is opened read-only");
+  run->add_option("--route", options->route,
+                  "With --localize-only: follow this route of the map (`edgeslam route make`): an "
+                  "instruction every frame (instructions.csv, progress line, viewer) and the "
+                  "checkpoint success rate in metrics.json");
+  run->add_option("--checkpoint-radius", options->checkpoint_radius_m,
+                  "With --route: a checkpoint succeeds when announced while the true position is "
+                  "within this many metres of it")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   run->add_option("--out", options->out_dir,
                   "Output folder (trajectories, metrics.json, frames.csv with each frame's times)");
   run->add_option("--viewer", options->viewer_port,

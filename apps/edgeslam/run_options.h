@@ -38,6 +38,8 @@ struct RunOptions {
   bool fast = false;                 // explicit request for the default
   bool deterministic = false;        // local: lock-step back end, one thread, identical runs
   bool localize_only = false;        // local: localise in the stored map --map, change nothing
+  std::string route;                 // with localize_only: follow this route of the map
+  double checkpoint_radius_m = 0.5;  // a checkpoint counts reached within this of the truth
   std::filesystem::path out_dir;
   std::optional<int> viewer_port;  // serve the web viewer (0 = any free port)
   std::string viewer_host = "127.0.0.1";

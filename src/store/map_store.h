@@ -71,6 +71,18 @@ struct MapStoreBatch {
   }
 };
 
+// A route on a map, for navigation: checkpoints in the map's frame, in the order they are to be
+// reached (`edgeslam route`).
+struct RouteRecord {
+  std::string name;
+  // What the checkpoints were made from, for people ("keyframes of session 1, frames 500-999").
+  std::string source;
+  double spacing_m = 0.0;  // along the path between checkpoints (0: positions given one by one)
+  Eigen::Vector3d up = -Eigen::Vector3d::UnitY();  // the map's up, unit: turns are about it
+  std::vector<Eigen::Vector3d> checkpoints;
+  double created = 0.0;  // Unix seconds
+};
+
 struct StoredSession {
   StoreSessionId id = 0;
   StoredSessionInfo info;
@@ -104,6 +116,11 @@ class MapStore {
   // A stored session written to again (a server resuming it after a restart): open again.
   virtual void resumeSession(StoreSessionId session) = 0;
   virtual bool removeMap(const std::string& name) = 0;
+  // Routes of a map (saved with it, removed with it). saveRoute replaces a route of that name;
+  // throws StoreError when the map does not exist.
+  virtual void saveRoute(const std::string& map, const RouteRecord& route) = 0;
+  virtual std::vector<RouteRecord> listRoutes(const std::string& map) = 0;
+  virtual bool removeRoute(const std::string& map, const std::string& route) = 0;
 };
 
 enum class MapStoreAccess {

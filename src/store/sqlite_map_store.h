@@ -26,6 +26,10 @@ class SqliteMapStore : public MapStore {
   void endSession(StoreSessionId session) override;
   void resumeSession(StoreSessionId session) override;
   bool removeMap(const std::string& name) override;
+  // In sqlite_routes.cpp.
+  void saveRoute(const std::string& map, const RouteRecord& route) override;
+  std::vector<RouteRecord> listRoutes(const std::string& map) override;
+  bool removeRoute(const std::string& map, const std::string& route) override;
 
  private:
   struct Statements;

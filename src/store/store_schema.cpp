@@ -26,6 +26,20 @@ CREATE TABLE keyframe_places(
 )sql");
 }
 
+void createRoutes(SqliteDatabase& db) {
+  db.execute(R"sql(
+CREATE TABLE routes(
+  map_id INTEGER NOT NULL REFERENCES maps(id) ON DELETE CASCADE,
+  name TEXT NOT NULL,
+  source TEXT NOT NULL,
+  spacing_m REAL NOT NULL,
+  up_x REAL NOT NULL, up_y REAL NOT NULL, up_z REAL NOT NULL,
+  checkpoints BLOB NOT NULL,
+  created REAL NOT NULL,
+  PRIMARY KEY(map_id, name)) WITHOUT ROWID;
+)sql");
+}
+
 void createTables(SqliteDatabase& db) {
   db.execute(R"sql(
 CREATE TABLE maps(
@@ -81,12 +95,14 @@ CREATE TABLE masks(
   PRIMARY KEY(session_id, keyframe)) WITHOUT ROWID;
 )sql");
   createKeyFramePlaces(db);
+  createRoutes(db);
 }
 
 // Migrations from version v to v + 1, in order; index 0 upgrades version 1. Version 1 -> 2 adds
-// the keyframes' places (empty: keyframes stored before are described when they are loaded).
+// the keyframes' places (empty: keyframes stored before are described when they are loaded);
+// 2 -> 3 adds the routes table (empty).
 using Migration = void (*)(SqliteDatabase&);
-constexpr Migration kMigrations[] = {createKeyFramePlaces};
+constexpr Migration kMigrations[] = {createKeyFramePlaces, createRoutes};
 static_assert(std::size(kMigrations) == kSchemaVersion - 1);
 
 int tableCount(SqliteDatabase& db) {

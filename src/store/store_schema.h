@@ -9,7 +9,8 @@ namespace edgeslam {
 // (position, appearance, observations as a blob), masks (semantic labels).
 // Version 2: keyframe_places (each keyframe's bag of words and direct index, and the vocabulary
 // that made them).
-constexpr int kSchemaVersion = 2;
+// Version 3: routes (a map's navigation routes: checkpoints in the map's frame).
+constexpr int kSchemaVersion = 3;
 // Readers (list, info, export) open stores of this version on without migrating them: what later
 // versions added is optional to them.
 constexpr int kOldestReadableSchemaVersion = 1;

@@ -53,6 +53,7 @@ nlohmann::json statusJson(const RunStatus& s) {
           {"sensor", s.sensor},
           {"link", s.link},
           {"adaptation_row", s.adaptation_row},
+          {"instruction", s.instruction},
           {"finished", s.finished}};
 }
 

@@ -30,6 +30,7 @@ struct RunStatus {
   std::string link;         // the emulated link profile ("none" without one)
   int adaptation_row = -1;  // Table I row in use (0-based); -1 without self-adaptation
   bool finished = false;    // the run is over (the viewer lingers on the final map)
+  std::string instruction;  // following a route: the latest navigation instruction ("" without)
 };
 
 struct ViewPose {

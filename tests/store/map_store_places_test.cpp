@@ -7,6 +7,7 @@
 #include "place/vocabulary_training.h"
 #include "store/map_store.h"
 #include "store/map_store_writer.h"
+#include "store/store_schema.h"
 #include "store/stored_map_loader.h"
 #include "store_fixture.h"
 
@@ -131,9 +132,10 @@ TEST(MapStorePlaces, VersionOneStoreOpensAndAWriterMigratesIt) {
   // What edgeslam wrote before schema version 2.
   sqlite3* db = nullptr;
   ASSERT_EQ(sqlite3_open((dir / "maps.sqlite").c_str(), &db), SQLITE_OK);
-  ASSERT_EQ(sqlite3_exec(db, "DROP TABLE keyframe_places; PRAGMA user_version = 1", nullptr,
-                         nullptr, nullptr),
-            SQLITE_OK);
+  ASSERT_EQ(
+      sqlite3_exec(db, "DROP TABLE keyframe_places; DROP TABLE routes; PRAGMA user_version = 1",
+                   nullptr, nullptr, nullptr),
+      SQLITE_OK);
   sqlite3_close(db);
   {
     auto reader = openMapStore(dir, MapStoreAccess::kRead);
@@ -160,7 +162,7 @@ TEST(MapStorePlaces, VersionOneStoreOpensAndAWriterMigratesIt) {
   sqlite3_stmt* version = nullptr;
   ASSERT_EQ(sqlite3_prepare_v2(db, "PRAGMA user_version", -1, &version, nullptr), SQLITE_OK);
   ASSERT_EQ(sqlite3_step(version), SQLITE_ROW);
-  EXPECT_EQ(sqlite3_column_int(version, 0), 2);
+  EXPECT_EQ(sqlite3_column_int(version, 0), kSchemaVersion);  // migrated through every version
   sqlite3_finalize(version);
   sqlite3_close(db);
   std::filesystem::remove_all(dir);

@@ -1,0 +1,158 @@
+#include "nav/navigator.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <stdexcept>
+
+namespace edgeslam {
+namespace {
+
+double distanceToSegment(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                         const Eigen::Vector3d& b) {
+  const Eigen::Vector3d ab = b - a;
+  const double length2 = ab.squaredNorm();
+  const double t = length2 > 0.0 ? std::clamp((p - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
+  return (a + t * ab - p).norm();
+}
+
+Eigen::Vector3d onGround(const Eigen::Vector3d& v, const Eigen::Vector3d& up) {
+  return v - v.dot(up) * up;
+}
+
+}  // namespace
+
+void NavigatorOptions::check() const {
+  if (!(reach_radius_m >= 0.0) || !(off_route_m > 0.0) || !(straight_within_deg >= 0.0) ||
+      !(straight_within_deg < 180.0)) {
+    throw std::invalid_argument(
+        "navigator: reach radius >= 0, off-route distance > 0 and straight tolerance in "
+        "[0, 180) degrees");
+  }
+}
+
+const char* toString(InstructionKind kind) {
+  switch (kind) {
+    case InstructionKind::kNoPose:
+      return "no_pose";
+    case InstructionKind::kGoStraight:
+      return "straight";
+    case InstructionKind::kTurnLeft:
+      return "left";
+    case InstructionKind::kTurnRight:
+      return "right";
+    case InstructionKind::kCheckpointReached:
+      return "checkpoint";
+    case InstructionKind::kOffRoute:
+      return "off_route";
+    case InstructionKind::kArrived:
+      return "arrived";
+  }
+  return "?";
+}
+
+std::string Instruction::text(std::size_t checkpoints) const {
+  switch (kind) {
+    case InstructionKind::kNoPose:
+      return "localising...";
+    case InstructionKind::kGoStraight:
+      return fmt::format("go straight to checkpoint {} of {} ({:.2f} m)", checkpoint + 1,
+                         checkpoints, distance_m);
+    case InstructionKind::kTurnLeft:
+    case InstructionKind::kTurnRight:
+      return fmt::format("turn {} by {:.0f} deg to checkpoint {} of {} ({:.2f} m)",
+                         kind == InstructionKind::kTurnLeft ? "left" : "right", turn_deg,
+                         checkpoint + 1, checkpoints, distance_m);
+    case InstructionKind::kCheckpointReached:
+      return fmt::format("checkpoint {} of {} reached", checkpoint + 1, checkpoints);
+    case InstructionKind::kOffRoute:
+      return fmt::format("off route ({:.2f} m from it)", distance_m);
+    case InstructionKind::kArrived:
+      return fmt::format("arrived: all {} checkpoints behind", checkpoints);
+  }
+  return "";
+}
+
+Navigator::Navigator(RouteRecord route, NavigatorOptions options)
+    : route_(std::move(route)), options_(options) {
+  options_.check();
+  if (route_.checkpoints.empty()) throw std::invalid_argument("the route has no checkpoints");
+  if (!(route_.up.norm() > 0.0)) throw std::invalid_argument("the route has no up direction");
+  route_.up.normalize();
+  reach_radius_m_ = options_.reach_radius_m > 0.0 ? options_.reach_radius_m
+                    : route_.spacing_m > 0.0      ? 0.5 * route_.spacing_m
+                                                  : 0.25;
+}
+
+double Navigator::distanceToRoute(const Eigen::Vector3d& position) const {
+  const auto& points = route_.checkpoints;
+  if (points.size() == 1) return (points[0] - position).norm();
+  // The legs around where the walker should be: the one into the next checkpoint and one on.
+  const std::size_t first = next_ == 0 ? 0 : next_ - 1;
+  const std::size_t last = std::min(points.size() - 1, next_ + 1 + options_.look_ahead);
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t i = first; i < last; ++i) {
+    best = std::min(best, distanceToSegment(position, points[i], points[i + 1]));
+  }
+  if (first == last) best = (points[first] - position).norm();
+  return best;
+}
+
+Instruction Navigator::update(const std::optional<SE3d>& T_cw) {
+  Instruction out;
+  const std::size_t count = route_.checkpoints.size();
+  if (next_ >= count) {
+    out.kind = InstructionKind::kArrived;
+    out.checkpoint = count - 1;
+    return out;
+  }
+  if (!T_cw) return out;
+  const SE3d T_wc = T_cw->inverse();
+  const Eigen::Vector3d position = T_wc.translation();
+  // Reached: the farthest checkpoint within reach among the next few.
+  const std::size_t last = std::min(count - 1, next_ + options_.look_ahead);
+  for (std::size_t k = last + 1; k-- > next_;) {
+    const double distance = (route_.checkpoints[k] - position).norm();
+    if (distance <= reach_radius_m_) {
+      reached_.push_back(k);
+      next_ = k + 1;
+      out.kind = InstructionKind::kCheckpointReached;
+      out.checkpoint = k;
+      out.distance_m = distance;
+      return out;
+    }
+  }
+  const double off = distanceToRoute(position);
+  if (off > options_.off_route_m) {
+    ++off_route_updates_;
+    out.kind = InstructionKind::kOffRoute;
+    out.checkpoint = next_;
+    out.distance_m = off;
+    return out;
+  }
+  const Eigen::Vector3d& up = route_.up;
+  const Eigen::Vector3d to_checkpoint = route_.checkpoints[next_] - position;
+  const Eigen::Vector3d heading = onGround(T_wc.rotationMatrix().col(2), up);
+  const Eigen::Vector3d bearing = onGround(to_checkpoint, up);
+  out.checkpoint = next_;
+  out.distance_m = to_checkpoint.norm();
+  if (heading.norm() < 1e-6 || bearing.norm() < 1e-6) {
+    out.kind = InstructionKind::kGoStraight;  // looking straight up or down, or on top of it
+    return out;
+  }
+  // Counter-clockwise about up (seen from above) is to the left.
+  const double angle =
+      std::atan2(up.dot(heading.cross(bearing)), heading.dot(bearing)) * 180.0 / std::numbers::pi;
+  if (std::abs(angle) <= options_.straight_within_deg) {
+    out.kind = InstructionKind::kGoStraight;
+  } else {
+    out.kind = angle > 0.0 ? InstructionKind::kTurnLeft : InstructionKind::kTurnRight;
+    out.turn_deg = std::abs(angle);
+  }
+  return out;
+}
+
+}  // namespace edgeslam

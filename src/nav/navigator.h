@@ -1,0 +1,76 @@
+#pragma once
+// Turn-by-turn guidance along a route, as in the paper's robot study: from each pose the client
+// reports, the next instruction (go straight / turn by an angle / checkpoint reached / off route).
+#include <Eigen/Core>
+#include <cstddef>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "geometry/se3.h"
+#include "store/map_store.h"
+
+namespace edgeslam {
+
+struct NavigatorOptions {
+  // A checkpoint is reached when the estimated position comes this close (0: half the route's
+  // spacing, or 0.25 m for a route of given positions).
+  double reach_radius_m = 0.0;
+  double off_route_m = 1.0;  // farther than this from the route's next legs: off route
+  double straight_within_deg = 20.0;
+  // Later checkpoints that count as reached too, skipping those before (a walker cutting a corner
+  // past one). 0: in order only, the default, since a path that crosses itself (a room walked
+  // round) passes near later checkpoints early.
+  std::size_t look_ahead = 0;
+  void check() const;  // throws std::invalid_argument
+};
+
+enum class InstructionKind {
+  kNoPose,  // not localised: no instruction
+  kGoStraight,
+  kTurnLeft,
+  kTurnRight,
+  kCheckpointReached,
+  kOffRoute,
+  kArrived,  // every checkpoint is behind
+};
+
+const char* toString(InstructionKind kind);
+
+struct Instruction {
+  InstructionKind kind = InstructionKind::kNoPose;
+  std::size_t checkpoint = 0;  // 0-based: the one reached, or the next one to go to
+  double turn_deg = 0.0;       // by how much to turn (positive), for kTurnLeft/kTurnRight
+  double distance_m = 0.0;     // to the checkpoint, or from the route when off it
+  // One line for people: "turn left by 35 deg to checkpoint 4 of 12 (1.20 m)".
+  std::string text(std::size_t checkpoints) const;
+};
+
+class Navigator {
+ public:
+  // Throws std::invalid_argument for a route without checkpoints or bad options.
+  Navigator(RouteRecord route, NavigatorOptions options = {});
+
+  // `T_cw`: the camera's pose in the map's frame this frame, if it has one.
+  Instruction update(const std::optional<SE3d>& T_cw);
+
+  const RouteRecord& route() const { return route_; }
+  double reachRadius() const { return reach_radius_m_; }
+  std::size_t nextCheckpoint() const { return next_; }
+  // Checkpoints the navigator saw reached (by the estimated pose), in order; skipped ones are
+  // not in it.
+  const std::vector<std::size_t>& reached() const { return reached_; }
+  std::size_t offRouteUpdates() const { return off_route_updates_; }
+
+ private:
+  double distanceToRoute(const Eigen::Vector3d& position) const;
+
+  RouteRecord route_;
+  NavigatorOptions options_;
+  double reach_radius_m_ = 0.0;
+  std::size_t next_ = 0;
+  std::vector<std::size_t> reached_;
+  std::size_t off_route_updates_ = 0;
+};
+
+}  // namespace edgeslam
