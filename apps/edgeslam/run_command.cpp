@@ -34,7 +34,9 @@
 #include "progress_line.h"
 #include "repeat_passes.h"
 #include "route_following.h"
+#include "run_metrics.h"
 #include "run_options.h"
+#include "run_slam_options.h"
 #include "run_viewer.h"
 #include "segmenter_option.h"
 #include "semantic_evaluation.h"
@@ -48,21 +50,6 @@
 namespace edgeslam::cli {
 namespace {
 
-nlohmann::json toJson(const PercentileSummary& s) {
-  return {{"median", s.median}, {"p90", s.p90}, {"p95", s.p95}, {"p99", s.p99}, {"max", s.max}};
-}
-
-nlohmann::json frameRangeJson(const std::optional<FrameRange>& range, std::size_t played) {
-  return {{"first", range ? range->first : 0}, {"count", played}};
-}
-
-nlohmann::json keyFrameDecisionsJson(const KeyFrameDecisionCounts& c) {
-  return {{"rules", c.by_rules},
-          {"forced", c.forced},
-          {"starving", c.starving},
-          {"segmentation", c.for_segmentation}};
-}
-
 std::string resolveSensor(const std::string& requested, const DatasetInfo& info) {
   if (requested == "auto") return info.has_depth ? "rgbd" : "mono";
   if (requested == "rgbd" && !info.has_depth) {
@@ -74,21 +61,6 @@ std::string resolveSensor(const std::string& requested, const DatasetInfo& info)
                                 " has none");
   }
   return requested;
-}
-
-std::optional<nlohmann::json> ateJson(const Trajectory& gt, const Trajectory& est,
-                                      AlignMode align) {
-  if (gt.empty() || est.size() < 3) return std::nullopt;
-  const PosePairs pairs = associateByTimestamp(gt, est);
-  if (pairs.size() < minimumPairsForAlignment(align)) return std::nullopt;
-  const AteResult ate = computeAte(pairs, align);
-  return nlohmann::json{{"rmse_m", ate.translation.rmse},
-                        {"mean_m", ate.translation.mean},
-                        {"median_m", ate.translation.median},
-                        {"max_m", ate.translation.max},
-                        {"pairs", ate.translation.count},
-                        {"scale", ate.alignment.scale()},
-                        {"align", toString(align)}};
 }
 
 // Test hook (tests/pipeline/live_camera_command_test.cpp): EDGESLAM_TEST_EXTRA_LOAD_MS makes each
@@ -280,93 +252,8 @@ int runPipeline(const RunOptions& given) {
                toString(info.format), info.frame_count, info.fps, reader->camera().describe());
   const std::string mode = options.mode;
 
-  SlamOptions slam_options = defaultSlamOptions(reader->camera(), sensor);
-  if (mode == "edge") {
-    slam_options.orb.num_features = std::min(slam_options.orb.num_features, kEdgeClientMaxFeatures);
-  }
-  if (options.features) slam_options.orb.num_features = *options.features;
-  if (options.levels) slam_options.orb.num_levels = *options.levels;
-  KeyFrameParameters& kf = slam_options.tracker.keyframes;
-  if (options.fmin) kf.fmin = *options.fmin;
-  if (options.fmax) kf.fmax = *options.fmax;
-  if (options.alpha) kf.alpha = *options.alpha;
-  if (options.beta) kf.beta = *options.beta;
-  if (options.starving) kf.starving_ratio = *options.starving;
-  slam_options.orb.validate();
-  slam_options.tracker.vocabulary = loadVocabulary(options.vocabulary);
-  slam_options.tracker.recover_within_frames = options.recover_frames;
-  // The mobile view draws each feature by state; without a viewer nothing is copied.
-  slam_options.tracker.report_feature_positions = options.viewer_port.has_value();
-  slam_options.backend.vocabulary = slam_options.tracker.vocabulary;
-  slam_options.backend.loop_closing = options.loop_closing;
-  slam_options.client_triangulation = options.client_triangulation;
-  // Paced frames have a deadline and the background has the time between them; unpaced (--fast)
-  // tracking always has work, so lowering the mapper would starve it of keyframes.
-  slam_options.backend.thread_nice = options.realtime ? kBackgroundNiceWhenPaced : 0;
-  // Unpaced, tracking waits for the back end instead of outrunning it (issue 24: KITTI 03 mono
-  // drifted to 2.92 m against 0.71 m paced); paced, a late client drops frames instead.
-  slam_options.wait_for_backend = !options.realtime;
-  if (options.triangulation_search) {
-    slam_options.backend.mapper.triangulation_search =
-        *parseTriangulationSearch(*options.triangulation_search);
-  }
-  if (options.deterministic) {
-    if (mode != "local") {
-      throw CLI::ValidationError("--deterministic",
-                                 "applies to --mode local only (edge and offload runs cross "
-                                 "processes or threads that are not in lock-step)");
-    }
-    // The back end runs inside the tracking thread, after each frame; OpenCV's pool stays out of
-    // feature extraction so nothing depends on the order threads finish in.
-    slam_options.backend.threaded = false;
-    cv::setNumThreads(1);
-  }
-  if (options.localize_only) {
-    if (mode != "local") {
-      throw CLI::ValidationError("--localize-only",
-                                 "applies to --mode local only so far (the edge does not yet "
-                                 "relocalise a client in a stored map)");
-    }
-    if (options.map_name.empty()) {
-      throw CLI::ValidationError("--localize-only",
-                                 "needs --map NAME: the stored map to localise in");
-    }
-    if (options.semantic) {
-      throw CLI::ValidationError("--localize-only",
-                                 "and --semantic on: masks come from segmented keyframes, and "
-                                 "localisation makes none");
-    }
-  }
-  if (!options.route.empty() && !options.localize_only) {
-    throw CLI::ValidationError("--route",
-                               "needs --localize-only: a route is followed in a stored map");
-  }
-  if (options.refine_intrinsics && mode != "local") {
-    spdlog::warn("--refine-intrinsics applies to --mode local only; the {} run keeps the camera",
-                 mode);
-  }
-  // The sensor's bounds (defaultSlamOptions) stay; the flag picks what is refined.
-  slam_options.intrinsics_refinement =
-      parseRefinedIntrinsics(options.refine_intrinsics.value_or("focal,k1"),
-                             slam_options.intrinsics_refinement)
-          .value();
-  slam_options.refine_intrinsics = refinesAnything(slam_options.intrinsics_refinement);
-  slam_options.semantic = options.semantic;
-  slam_options.keyframe_image_reduce = options.segment_reduce;
-  slam_options.segmentation_refresh.max_frames = options.segment_refresh;
-  slam_options.segmentation_refresh.min_frames = options.segment_refresh_min.value_or(
-      std::min(slam_options.segmentation_refresh.min_frames, options.segment_refresh));
-  if (options.semantic && options.server_address.empty()) {
-    // The segmenter runs on its own thread beside tracking (and, embedded, beside the edge's
-    // mapping) in this process; OpenCV's default pool would spread each inference over every
-    // core and stall tracking (RGB-D edge run: end-to-end median 520 ms instead of ~40 ms).
-    cv::setNumThreads(1);
-    // Loaded here also for the embedded edge: a missing model is reported before any frame is
-    // read. A remote edge server checks its own models when the session opens.
-    std::shared_ptr<Segmenter> segmenter =
-        loadSegmenter(segmenterOptions(options.models_dir, options.segment_input));
-    if (mode == "local") slam_options.backend.segmenter = std::move(segmenter);
-  }
+  SlamOptions slam_options = slamOptionsForRun(options, reader->camera(), sensor);
+  const KeyFrameParameters& kf = slam_options.tracker.keyframes;
   spdlog::info("{} ORB features, {} levels; keyframes fmin {} fmax {} alpha {} beta {}",
                slam_options.orb.num_features, slam_options.orb.num_levels, kf.fmin, kf.fmax,
                kf.alpha, kf.beta);
@@ -638,56 +525,15 @@ int runPipeline(const RunOptions& given) {
                                    {"keyframe", toJson(counters.keyframe_ms)}};
   }
   if (const AdaptationLoop* adaptation = slam.adaptation()) {
-    const AdaptationLoop& loop = *adaptation;
-    const AdaptationLoopCounters c = loop.counters();
-    const NetworkEstimates n = loop.estimates();
-    const auto optional_json = [](const std::optional<double>& v) {
-      return v ? nlohmann::json(*v) : nlohmann::json(nullptr);
-    };
-    metrics["adapt"] = {{"enabled", loop.adapting()},
-                        {"switches", c.switches},
-                        {"frames_per_config", c.frames_per_config},
-                        {"probe_bytes", c.probe_bytes},
-                        {"failed_probes", c.failed_probes},
-                        {"latency_ms", optional_json(n.latency_ms)},
-                        {"bandwidth_mbps", optional_json(n.bandwidth_mbps)},
-                        {"network_time_ms", optional_json(n.network_time_ms)},
-                        {"message_bytes", n.message_bytes}};
+    metrics["adapt"] = adaptationJson(*adaptation);
     // Probes share the channel: keep them out of the per-keyframe figure.
+    const std::uint64_t probe_bytes = adaptation->counters().probe_uplink_bytes;
     metrics["bytes_per_keyframe"] =
-        (counters.uplink_bytes -
-         std::min<std::uint64_t>(counters.uplink_bytes, c.probe_uplink_bytes)) /
+        (counters.uplink_bytes - std::min<std::uint64_t>(counters.uplink_bytes, probe_bytes)) /
         keyframes_uploaded;
   }
   if (const std::optional<SplitClientReport> split = slam.splitClientReport()) {
-    // The client's own map; keyframes / map_points above are the edge's global map.
-    const ClientMapSize& c = split->client_map;
-    metrics["client_map"] = {{"window_keyframes", options.client_map_keyframes},
-                             {"keyframes", c.keyframes},
-                             {"points", c.points},
-                             {"max_keyframes", c.max_keyframes},
-                             {"max_points", c.max_points},
-                             {"keyframes_evicted", c.keyframes_evicted},
-                             {"keyframes_entered", c.keyframes_entered}};
-    // Every keyframe the client made is on the edge, culled there as redundant, on its way, or
-    // lost for a reason below.
-    const ResyncCounters& r = split->resync;
-    metrics["resync"] = {{"full_resyncs", r.full_resyncs},
-                         {"keyframes_made", counters.keyframes_uploaded - r.keyframes_resent},
-                         {"keyframes_resent", r.keyframes_resent},
-                         {"keyframes_culled_by_edge", r.keyframes_culled_by_edge},
-                         {"keyframes_lost",
-                          {{"upload_dropped", counters.keyframes_forgotten},
-                           {"evicted_before_stored", r.keyframes_lost_evicted}}}};
-    const KeyFrameTriangulationStats& t = split->triangulation;
-    if (t.keyframes > 0) {
-      const PercentileSummary ms = t.ms.summary();
-      metrics["client_triangulation"] = {
-          {"keyframes", t.keyframes},
-          {"points_created", t.points_created},
-          {"ms_per_keyframe",
-           {{"median", ms.median}, {"p90", ms.p90}, {"p95", ms.p95}, {"max", ms.max}}}};
-    }
+    addSplitClientMetrics(metrics, *split, counters, options.client_map_keyframes);
   }
   if (options.semantic || semantic_eval) {
     nlohmann::json semantic = {{"enabled", options.semantic},
@@ -766,24 +612,11 @@ int runPipeline(const RunOptions& given) {
                (*ate)["rmse_m"].get<double>(), (*ate)["pairs"].get<std::size_t>());
   }
   if (pass_log) pass_log->print();
-  if (route) {
-    const nlohmann::json& nav = metrics["navigation"];
-    fmt::print("  route        '{}': {} checkpoints, {} announced reached", options.route,
-               nav["checkpoints"].get<std::size_t>(),
-               nav["reached_by_estimate"].get<std::size_t>());
-    if (nav.contains("success_rate")) {
-      fmt::print(
-          "; success {:.1f} % ({} within {:.2f} m of the truth; announced {:.2f} m from it, "
-          "median)",
-          100.0 * nav["success_rate"].get<double>(), nav["reached"].get<std::size_t>(),
-          nav["success_radius_m"].get<double>(), nav["announced_error_m"]["median"].get<double>());
-    }
-    fmt::print("\n");
-  }
   if (ate_final) {
     fmt::print("  ATE final    rmse {:.4f} m  ({} poses, refined)\n",
                (*ate_final)["rmse_m"].get<double>(), (*ate_final)["pairs"].get<std::size_t>());
   }
+  if (route) printRouteSummary(metrics["navigation"]);
   if (refinement) fmt::print("  intrinsics   {}\n", describe(*refinement));
   if (!store_metrics.is_null() && store_metrics.contains("bytes")) {
     fmt::print(
