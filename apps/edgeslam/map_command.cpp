@@ -1,5 +1,6 @@
 // `edgeslam map list|info|export|rm`: the maps an edge store holds.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include <ctime>
@@ -92,6 +93,9 @@ int mapInfo(const MapCommandOptions& o) {
   const auto info = store->mapInfo(o.name);
   if (!info) noSuchMap(*store, o.name);
   nlohmann::json out = summaryJson(*info);
+  nlohmann::json routes = nlohmann::json::array();
+  for (const RouteRecord& route : store->listRoutes(o.name)) routes.push_back(route.name);
+  out["routes"] = routes;
   if (o.load) {
     // As a server resuming the map would: records read, then the maps rebuilt (covisibility too)
     // and, with a vocabulary, every keyframe given its bag of words (stored, else computed).
@@ -147,6 +151,7 @@ int mapInfo(const MapCommandOptions& o) {
   fmt::print("  {} keyframes, {} points, {} session(s), {} bytes\n", info->keyframes, info->points,
              info->sessions, info->bytes);
   fmt::print("  created {}, updated {}\n", isoTime(info->created), isoTime(info->updated));
+  if (!routes.empty()) fmt::print("  routes: {}\n", fmt::join(routes, ", "));
   if (o.load) {
     fmt::print(
         "  loaded in {:.1f} ms, {:.1f} ms of CPU (read {:.1f} ms, rebuilt {:.1f} ms, bags of words "

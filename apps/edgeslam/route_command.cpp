@@ -43,6 +43,11 @@ RouteRecord makeFromKeyFrames(MapStore& store, const RouteCommandOptions& o) {
     options.first_frame = range.first;
     options.last_frame = range.last;
   }
+  if (session->info.sensor == Sensor::kMonocular) {
+    spdlog::warn(
+        "map '{}' is monocular: it has no metric scale, so --every ({} m) is in the map's units",
+        o.map, o.spacing_m);
+  }
   return routeAlongKeyFrames(*session, options);
 }
 
