@@ -24,6 +24,13 @@ MapPoint* Map::loadPoint(const PointLoad& load) {
   if (!points_.emplace(id, std::move(owned)).second) {
     throw std::logic_error("Map: duplicate map point id");
   }
+  // The observers' keypoint slots and depths lie far apart: fetched together, not one cache miss
+  // after the other (they were most of the time of loading the points).
+  for (const auto& [keyframe, index] : load.observers) {
+    __builtin_prefetch(keyframe->points_.data() + index);
+    const std::vector<float>& depth = keyframe->features_->depth;
+    if (index < depth.size()) __builtin_prefetch(depth.data() + index);
+  }
   for (const auto& [keyframe, index] : load.observers) {
     MapPoint*& slot = keyframe->points_[index];
     if (slot == nullptr && !keyframe->isBad()) {
@@ -93,10 +100,8 @@ void Map::linkAllConnections() {
       const auto it = index_of.find(obs.keyframe);
       if (it == index_of.end()) continue;
       table.keyframes.push_back(it->second);
-      const auto& slots = obs.keyframe->points_;
-      if (obs.index < slots.size() && slots[obs.index] == point.get()) {
-        memberships.emplace_back(it->second, row);
-      }
+      // (The keypoint links the point back: Map keeps both sides in step.)
+      memberships.emplace_back(it->second, row);
     }
   }
   table.row_start.push_back(static_cast<std::uint32_t>(table.keyframes.size()));
