@@ -12,6 +12,26 @@
 
 namespace edgeslam {
 
+namespace {
+
+// A loaded point's descriptor: a row of a block of a few thousand, which the row keeps alive, in
+// place of two allocations (header and bytes) per point, a fifth of creating a stored map's points.
+// Rows are only read or replaced whole (MapPoint gives each new descriptor its own matrix).
+cv::Mat descriptorRow(const std::uint8_t* bytes) {
+  constexpr int kRowsPerBlock = 4096;
+  thread_local cv::Mat block;
+  thread_local int next = kRowsPerBlock;
+  if (next == kRowsPerBlock) {
+    block = cv::Mat(kRowsPerBlock, 32, CV_8U);
+    next = 0;
+  }
+  cv::Mat row = block.row(next++);
+  std::memcpy(row.data, bytes, 32);
+  return row;
+}
+
+}  // namespace
+
 MapPoint* Map::loadPoint(const PointLoad& load) {
   MapPointId id = load.id;
   if (id == kInvalidId) {
@@ -50,8 +70,7 @@ MapPoint* Map::loadPoint(const PointLoad& load) {
     recording_ = recording;
   }
   point->normal_ = load.normal;
-  point->descriptor_.create(1, 32, CV_8U);
-  std::memcpy(point->descriptor_.data, load.descriptor, 32);
+  point->descriptor_ = descriptorRow(load.descriptor);
   point->min_distance_ = load.min_distance;
   point->max_distance_ = load.max_distance;
   return point;
