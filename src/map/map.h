@@ -11,7 +11,9 @@
 #include <deque>
 #include <memory>
 #include <mutex>
+#include <span>
 #include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include "map/keyframe.h"
@@ -55,6 +57,24 @@ class Map {
                           float min_distance, float max_distance);
   // Recomputes normal, distance range and representative descriptor from the observations.
   void refreshPoint(MapPoint* point);
+
+  // Bulk load (a stored session into a map that has no points yet), none of it recorded as a
+  // change: room for `count` more points; each point as createMapPoint, addObservation on each
+  // observer in turn and setPointAppearance would make it; then every keyframe's covisibility
+  // links as updateConnections on each keyframe in id order would make them, counted in one pass.
+  struct PointLoad {
+    MapPointId id = kInvalidId;
+    Eigen::Vector3d position;
+    KeyFrame* reference = nullptr;
+    std::span<const std::pair<KeyFrame*, std::size_t>> observers;  // keyframe, keypoint index
+    Eigen::Vector3d normal;
+    const std::uint8_t* descriptor = nullptr;  // 32 bytes
+    float min_distance = 0.f;
+    float max_distance = 0.f;
+  };
+  void reservePoints(std::size_t count) { points_.reserve(points_.size() + count); }
+  MapPoint* loadPoint(const PointLoad& load);
+  void linkAllConnections();
 
   void setKeyFramePose(KeyFrame* keyframe, const SE3d& T_cw);
   void updateConnections(KeyFrame* keyframe);

@@ -174,6 +174,7 @@ Blob featureVectorBlob(const FeatureVector& features) {
 
 FeatureVector featureVectorFromBlob(BlobView blob) {
   std::vector<std::pair<NodeId, int>> pairs;
+  pairs.reserve(blob.size() / 4);  // at most one feature per 4 bytes
   std::size_t offset = 0;
   while (offset < blob.size()) {
     if (blob.size() - offset < 8) throw StoreError("damaged direct index blob (truncated node)");

@@ -20,8 +20,9 @@ namespace edgeslam {
 namespace {
 
 // A point record into a map that held nothing before the load: what upsertPointRecord does for a
-// point the map does not have, without looking the point up. (Its "made by this side after the
-// sender's newest keyframe" exception cannot arise: every keyframe is the sender's.)
+// point the map does not have, without looking the point up or recording the change. (Its "made
+// by this side after the sender's newest keyframe" exception cannot arise: every keyframe is the
+// sender's.)
 void createPointRecord(Map& map, const MapPointRecord& record,
                        std::vector<std::pair<KeyFrame*, std::size_t>>& observers) {
   observers.clear();
@@ -33,12 +34,14 @@ void createPointRecord(Map& map, const MapPointRecord& record,
   }
   if (observers.empty()) return;
   KeyFrame* reference = map.keyFrame(record.reference_keyframe);
-  MapPoint* point = map.createMapPoint(
-      record.position, reference != nullptr ? reference : observers[0].first, record.id);
-  for (const auto& [kf, index] : observers) map.addObservation(point, kf, index);
-  const cv::Mat descriptor(1, 32, CV_8U, const_cast<std::uint8_t*>(record.descriptor.data()));
-  map.setPointAppearance(point, record.normal, descriptor, record.min_distance,
-                         record.max_distance);
+  map.loadPoint({.id = record.id,
+                 .position = record.position,
+                 .reference = reference != nullptr ? reference : observers[0].first,
+                 .observers = observers,
+                 .normal = record.normal,
+                 .descriptor = record.descriptor.data(),
+                 .min_distance = record.min_distance,
+                 .max_distance = record.max_distance});
 }
 
 // Files the keyframes (with `features`, one per record) and the points into `map`, then links
@@ -65,6 +68,7 @@ void fillMap(const StoredSession& session, std::vector<std::shared_ptr<FrameFeat
     }
     const double keyframes_ms = timer.elapsedMs();
     std::vector<std::pair<KeyFrame*, std::size_t>> observers;
+    if (fresh) map.reservePoints(session.points.size());
     for (const MapPointRecord& record : session.points) {
       // (Point ids are unique in a session: a second record of one id fails to load.)
       if (fresh) {
@@ -75,7 +79,7 @@ void fillMap(const StoredSession& session, std::vector<std::shared_ptr<FrameFeat
       map.ids().advancePast(record.id);
     }
     const double points_ms = timer.elapsedMs();
-    for (KeyFrame* keyframe : map.keyFrames()) map.updateConnections(keyframe);
+    map.linkAllConnections();
     map.setChangeRecording(true);
     spdlog::debug(
         "stored session loaded: features {:.0f} ms, keyframes {:.0f} ms, points {:.0f} ms, "
