@@ -134,8 +134,10 @@ async function edgeView(browser) {
     '--semantic', 'off', '--vocab', 'none', '--status-every', '0', '--maps', path.join(outDir, 'maps')];
   const server = await start(serverArgs(0, '127.0.0.1:0'), /viewer: (http:\/\/[\d.]+:(\d+)\/)[\s\S]*listening on ([\d.]+:\d+)/, 'server');
   const [, url, viewerPort, address] = server.match;
-  const clientArgs = ['client', '--server', address, '--dataset', args.dataset, '--realtime', '--max-frames', '300',
-    '--vocab', 'none', '--out', path.join(outDir, 'client')];
+  // The client plays on until the test stops it: on a loaded host the page may take most of a
+  // minute to see the first session, and a client that had ended by then left nothing to update.
+  const clientArgs = ['client', '--server', address, '--dataset', args.dataset, '--realtime', '--frames', '0-299',
+    '--repeat', '100', '--vocab', 'none', '--out', path.join(outDir, 'client')];
   const client = await start(clientArgs, /frame/, 'client');
   const page = await browser.newPage();
   await page.setViewport({ width: 1280, height: 800, deviceScaleFactor: 1 });
