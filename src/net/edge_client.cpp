@@ -140,6 +140,13 @@ struct EdgeClient::Impl {
   bool reopenSession(std::uint64_t lost_session, const std::string& reason) {
     std::lock_guard lock(reopen_mutex);
     if (session_id.load() != lost_session) return true;  // another thread already did it
+    // Before the new session exists, so that every upload it takes is remembered; those the lost
+    // session took are not in the new one's map.
+    {
+      std::lock_guard state(mutex);
+      acknowledged_while_resyncing.clear();
+    }
+    resync_pending.store(true);
     const grpc::Status status = openSession(options.rpc_timeout);
     if (!status.ok()) {
       spdlog::warn("edge client: reopening the session failed: {}", describe(status));
@@ -147,11 +154,6 @@ struct EdgeClient::Impl {
     }
     ++session_reopens;
     last_applied.store(0);  // the new session's slices start at 1
-    {
-      std::lock_guard state(mutex);
-      acknowledged_while_resyncing.clear();  // by the lost session: not in the new one's map
-    }
-    resync_pending.store(true);
     spdlog::warn("edge client: session reopened ({}), id origin {}", reason, id_origin.load());
     notify({true, true, id_origin.load(), reason});
     return true;
