@@ -48,6 +48,7 @@ class EdgeKeyFrameSink : public KeyFrameSink {
   bool acceptsKeyFrames() const override;
   bool acceptsUrgentKeyFrames() const override;
   std::size_t lastOptimizedFrame() const override { return last_optimized_frame_.load(); }
+  bool mapUpdatesPaused() const override { return uplink_.reconnecting(); }
   void onMapReset() override;
 
   // The image of the frame about to be tracked: if that frame becomes a keyframe, the image goes

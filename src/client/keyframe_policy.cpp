@@ -20,8 +20,9 @@ KeyFrameDecision decideKeyFrame(const KeyFrameParameters& params, const KeyFrame
   // An overdue map update forces a keyframe only while the mapper can still take one: behind a
   // slow link the update is overdue because the edge is behind, and forcing one per frame then
   // flooded the upload queue (lte-congested: ~1 overflow per frame).
-  if ((e.frames_since_map_update >= static_cast<std::size_t>(params.fmax) ||
-       e.frames_since_keyframe >= static_cast<std::size_t>(params.fmax)) &&
+  const bool update_overdue =
+      !e.map_updates_paused && e.frames_since_map_update >= static_cast<std::size_t>(params.fmax);
+  if ((update_overdue || e.frames_since_keyframe >= static_cast<std::size_t>(params.fmax)) &&
       e.mapper_accepts_urgent) {
     return KeyFrameDecision::kYesForced;
   }

@@ -11,7 +11,10 @@
 //  (4) the frame's tracked points are fewer than beta times the reference keyframe's tracked points
 //      (the view has changed).
 // A frame is a keyframe when (3) holds and either (1) and (4) hold, or (2) is violated and the
-// mapper can take an urgent keyframe (else a slow edge would get one keyframe per frame).
+// mapper can take an urgent keyframe (else a slow edge would get one keyframe per frame). While
+// map updates are paused (the edge unreachable) only the keyframe gap counts for (2): the update
+// is overdue because of the outage, and forcing a keyframe per frame spent the whole allowance of
+// unanswered keyframes in the outage's first seconds, leaving tracking none for the rest of it.
 // Guard (why: with fmin = 10-40 frames, fast motion would lose tracking before the next keyframe is
 // allowed): when the tracked ratio falls below `starving_ratio`, rule (1) is waived.
 // Segmentation refresh (semantic culling on): people who walk into view appear in the movable mask
@@ -42,6 +45,7 @@ struct KeyFrameEvidence {
   std::size_t reference_tracked = 0;  // points of the reference keyframe seen by >= 2 keyframes
   bool mapper_accepts = true;         // false while the mapper is too busy to take one
   bool mapper_accepts_urgent = true;  // the same for a keyframe of starving tracking
+  bool map_updates_paused = false;    // no update can come for now (the edge is unreachable)
 };
 
 enum class KeyFrameDecision { kNo, kYes, kYesForced, kYesStarving, kYesForSegmentation };

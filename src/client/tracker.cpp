@@ -568,13 +568,15 @@ KeyFrameDecision Tracker::decide(const Frame& frame, int inliers) const {
   e.reference_tracked = static_cast<std::size_t>(reference_keyframe_->trackedPointCount(min_obs));
   e.mapper_accepts = sink_ == nullptr || sink_->acceptsKeyFrames();
   e.mapper_accepts_urgent = sink_ == nullptr || sink_->acceptsUrgentKeyFrames();
+  e.map_updates_paused = sink_ != nullptr && sink_->mapUpdatesPaused();
   const KeyFrameDecision decision = decideKeyFrame(options_.keyframes, e);
   spdlog::debug(
       "frame {}: keyframe decision {} (since kf {}, since map update {}, kfs {}, features {}/{}, "
-      "tracked {}/{}, mapper {})",
+      "tracked {}/{}, mapper {}{})",
       frame.index, static_cast<int>(decision), e.frames_since_keyframe, e.frames_since_map_update,
       e.keyframes_in_map, e.frame_features, e.reference_features, e.frame_tracked,
-      e.reference_tracked, e.mapper_accepts ? "accepts" : "busy");
+      e.reference_tracked, e.mapper_accepts ? "accepts" : "busy",
+      e.map_updates_paused ? ", updates paused" : "");
   return decision;
 }
 

@@ -18,6 +18,9 @@ class KeyFrameSink {
   virtual bool acceptsUrgentKeyFrames() const { return acceptsKeyFrames(); }
   // Index of the frame whose keyframe was last optimised into the map (keyframe rule 2).
   virtual std::size_t lastOptimizedFrame() const = 0;
+  // True while no map update can come (the edge is unreachable): an overdue update is then no
+  // reason for a keyframe.
+  virtual bool mapUpdatesPaused() const { return false; }
   // The map was emptied (a failed start): forget queued keyframes.
   virtual void onMapReset() = 0;
 };

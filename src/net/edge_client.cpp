@@ -140,6 +140,13 @@ struct EdgeClient::Impl {
   bool reopenSession(std::uint64_t lost_session, const std::string& reason) {
     std::lock_guard lock(reopen_mutex);
     if (session_id.load() != lost_session) return true;  // another thread already did it
+    // Before the new session exists, so that every upload it takes is remembered; those the lost
+    // session took are not in the new one's map.
+    {
+      std::lock_guard state(mutex);
+      acknowledged_while_resyncing.clear();
+    }
+    resync_pending.store(true);
     const grpc::Status status = openSession(options.rpc_timeout);
     if (!status.ok()) {
       spdlog::warn("edge client: reopening the session failed: {}", describe(status));
@@ -147,7 +154,6 @@ struct EdgeClient::Impl {
     }
     ++session_reopens;
     last_applied.store(0);  // the new session's slices start at 1
-    resync_pending.store(true);
     spdlog::warn("edge client: session reopened ({}), id origin {}", reason, id_origin.load());
     notify({true, true, id_origin.load(), reason});
     return true;
@@ -310,6 +316,7 @@ struct EdgeClient::Impl {
     in_flight = false;
     if (outcome == Outcome::kSent) {
       ++uploads_sent;
+      if (resync_pending.load()) acknowledged_while_resyncing.push_back(which.keyframe);
     } else {
       ++uploads_dropped;
     }
@@ -454,7 +461,11 @@ struct EdgeClient::Impl {
     }
     ++slices_received;
     last_applied.store(sequence);
-    if (full_resync) resync_pending.store(false);
+    if (full_resync) {
+      resync_pending.store(false);
+      std::lock_guard lock(mutex);
+      acknowledged_while_resyncing.clear();
+    }
   }
 
   // --- data ------------------------------------------------------------------------------------
@@ -482,6 +493,9 @@ struct EdgeClient::Impl {
   std::deque<KeyFrameUpload> queue;
   bool in_flight = false;
   KeyFrameId in_flight_keyframe = kInvalidId;
+  // Keyframes the session took while a full resync was pending: perhaps after the resync's
+  // snapshot of the edge's map, so not listed there, yet not lost.
+  std::vector<KeyFrameId> acknowledged_while_resyncing;
   std::uint64_t last_upload_sequence = 0;
   grpc::ClientContext* upload_context = nullptr;
   grpc::ClientContext* stream_context = nullptr;
@@ -527,8 +541,7 @@ bool EdgeClient::reconnecting() const {
 
 std::vector<KeyFrameId> EdgeClient::pendingUploadKeyFrames() const {
   std::lock_guard lock(impl_->mutex);
-  std::vector<KeyFrameId> out;
-  out.reserve(impl_->queue.size() + 1);
+  std::vector<KeyFrameId> out = impl_->acknowledged_while_resyncing;
   if (impl_->in_flight) out.push_back(impl_->in_flight_keyframe);
   for (const KeyFrameUpload& upload : impl_->queue) out.push_back(upload.keyframe.id);
   return out;

@@ -110,7 +110,9 @@ class EdgeClient {
   // The last upload attempt failed for want of the server (unreachable, or its session lost and
   // not reopened yet); false again once an upload goes through.
   bool reconnecting() const;
-  // Keyframes whose upload is queued or being sent (not yet acknowledged by the server).
+  // Keyframes on their way to the session's map: uploads queued or being sent, and those the
+  // session acknowledged while a full resync was pending (the resync's slice may have been taken
+  // before they arrived). A keyframe a full resync does not list and this does not name is lost.
   std::vector<KeyFrameId> pendingUploadKeyFrames() const;
 
   // Queues a keyframe and returns at once with its sequence (the caller's when non-zero, else the

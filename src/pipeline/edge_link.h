@@ -34,8 +34,9 @@ class EdgeLink : public KeyFrameUplink {
   // Ids of that origin the edge's map already held when the session opened (a stored map the
   // edge resumed): the client makes its ids above. 0 = none.
   virtual std::uint64_t idFloor() const { return 0; }
-  // Keyframes whose upload the link still holds (queued or being sent): after a full resync they
-  // are on their way, not lost.
+  // Keyframes whose upload the link still holds (queued or being sent), or that the edge's session
+  // took while a full resync was pending (after the resync's snapshot, perhaps): after a full
+  // resync they are on their way, not lost.
   virtual std::vector<KeyFrameId> pendingKeyFrames() const { return {}; }
   // Called on the link's own thread for every slice; set before the first upload.
   virtual void setSliceHandler(SliceHandler handler) = 0;

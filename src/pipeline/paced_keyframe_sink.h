@@ -36,6 +36,7 @@ class PacedKeyFrameSink : public KeyFrameSink {
   bool acceptsKeyFrames() const override;
   bool acceptsUrgentKeyFrames() const override { return inner_.acceptsUrgentKeyFrames(); }
   std::size_t lastOptimizedFrame() const override { return inner_.lastOptimizedFrame(); }
+  bool mapUpdatesPaused() const override { return inner_.mapUpdatesPaused(); }
   void onMapReset() override { inner_.onMapReset(); }
 
   BackendPacing pacing() const;

@@ -12,7 +12,9 @@ namespace {
 class RecordingUplink final : public KeyFrameUplink {
  public:
   void send(KeyFrameUpload upload) override { sent.push_back(upload.sequence); }
+  bool reconnecting() const override { return edge_unreachable; }
   std::vector<std::uint64_t> sent;
+  bool edge_unreachable = false;
 };
 
 TEST(EdgeKeyFrameSink, StarvingTrackingMayHaveAFewMoreUploadsInFlight) {
@@ -41,6 +43,27 @@ TEST(EdgeKeyFrameSink, StarvingTrackingMayHaveAFewMoreUploadsInFlight) {
   sink.onSliceApplied(5, 4);
   EXPECT_TRUE(sink.acceptsKeyFrames());
   EXPECT_EQ(uplink.sent.size(), 5u);
+}
+
+// While the edge is unreachable tracking may leave more keyframes unanswered, and no map update
+// can come: an overdue one then forces no keyframe (keyframe_policy.h).
+TEST(EdgeKeyFrameSink, MapUpdatesArePausedWhileTheEdgeIsUnreachable) {
+  Map map;
+  RecordingUplink uplink;
+  EdgeKeyFrameSinkOptions options;
+  options.max_in_flight = 1;
+  options.urgent_extra_in_flight = 0;
+  options.max_in_flight_reconnecting = 2;
+  EdgeKeyFrameSink sink(map, uplink, options);
+  const auto features = test::emptyFeatures(test::syntheticCamera());
+  EXPECT_FALSE(sink.mapUpdatesPaused());
+  sink.insertKeyFrame(map.createKeyFrame(0, 0.0, features, SE3d()));
+  EXPECT_FALSE(sink.acceptsKeyFrames());
+  uplink.edge_unreachable = true;
+  EXPECT_TRUE(sink.mapUpdatesPaused());
+  EXPECT_TRUE(sink.acceptsKeyFrames());
+  uplink.edge_unreachable = false;
+  EXPECT_FALSE(sink.mapUpdatesPaused());
 }
 
 }  // namespace

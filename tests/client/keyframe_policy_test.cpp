@@ -53,6 +53,24 @@ TEST(KeyFramePolicy, AnOverdueMapUpdateForcesNothingPastTheUrgentBound) {
   EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kNo);
 }
 
+// The edge unreachable: the update is overdue because of the outage, and a keyframe per frame
+// spent the unanswered-keyframe allowance in the outage's first seconds (24 keyframes in 75
+// frames of a loaded run, then none for 6 s, and tracking was lost).
+TEST(KeyFramePolicy, WhileMapUpdatesArePausedOnlyTheKeyFrameGapForces) {
+  KeyFrameEvidence e = healthy();
+  e.frames_since_map_update = 200;
+  e.map_updates_paused = true;
+  EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kNo);
+  e.frames_since_keyframe = 60;
+  EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kYesForced);
+  // The other rules hold as ever.
+  e.frames_since_keyframe = 21;
+  e.frame_tracked = 250;
+  EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kYes);
+  e.frame_tracked = 80;
+  EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kYesStarving);
+}
+
 TEST(KeyFramePolicy, Rule3RejectsPoorImages) {
   KeyFrameEvidence e = healthy();
   e.frames_since_map_update = 100;

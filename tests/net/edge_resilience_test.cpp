@@ -5,6 +5,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <condition_variable>
+#include <mutex>
 #include <random>
 
 #include "edgeslam/v1/edgeslam.grpc.pb.h"
@@ -167,6 +169,69 @@ TEST(EdgeResilience, ClientReconnectsAndResumesAfterAServerRestart) {
   EXPECT_TRUE(events.front().reopened);
   EXPECT_TRUE(events.front().full_resync_needed);
   EXPECT_EQ(events.front().id_origin, origin);
+}
+
+// The full resync's slice is the edge's map when the client asked for it; uploads the new session
+// takes before the client has applied it are not listed there, yet not lost. Under load the
+// client applied the resync 1.3 s after it was made, and re-sent the 16 keyframes the session had
+// taken meanwhile (each counted in flight, holding tracking's keyframes back).
+TEST(EdgeResilience, UploadsTheNewSessionTookDuringItsResyncAreOnTheirWay) {
+  auto server = std::make_unique<EdgeServer>("127.0.0.1:0", std::make_shared<FakeFactory>());
+  const int port = server->port();
+  std::mutex resync_mutex;
+  std::condition_variable resync_changed;
+  bool in_resync = false;
+  bool release_resync = false;
+  EdgeClient* client_ptr = nullptr;
+  std::vector<KeyFrameId> on_their_way;
+  EdgeClientOptions options = quickOptions();
+  options.on_slice = [&](MapSlice slice) {
+    if (!slice.full_resync) return;
+    std::unique_lock lock(resync_mutex);
+    in_resync = true;
+    resync_changed.notify_all();
+    // A slow applier: the uploads go on meanwhile.
+    resync_changed.wait_for(lock, 15s, [&] { return release_resync; });
+    on_their_way = client_ptr->pendingUploadKeyFrames();
+  };
+  EdgeClient client(server->address(), test::sampleSessionConfig(), options);
+  client_ptr = &client;
+  std::mt19937 rng(19);
+  const auto upload = [&](std::uint64_t sequence) {
+    KeyFrameUpload u = test::sampleUpload(sequence, 50, 2, rng);
+    const KeyFrameId id = u.keyframe.id;
+    client.uploadKeyFrame(std::move(u));
+    return id;
+  };
+  upload(1);
+  ASSERT_TRUE(client.flushUploads(10s));
+
+  server->shutdown();
+  server.reset();
+  EdgeServer restarted("127.0.0.1:" + std::to_string(port), std::make_shared<FakeFactory>());
+  const KeyFrameId first_after = upload(2);
+  {
+    std::unique_lock lock(resync_mutex);
+    ASSERT_TRUE(resync_changed.wait_for(lock, 15s, [&] { return in_resync; }));
+  }
+  // While the client applies the resync: the new session takes two more.
+  const std::vector<KeyFrameId> taken = {first_after, upload(3), upload(4)};
+  ASSERT_TRUE(client.flushUploads(10s));
+  EXPECT_EQ(client.pendingUploads(), 0u);
+  {
+    std::lock_guard lock(resync_mutex);
+    release_resync = true;
+  }
+  resync_changed.notify_all();
+  ASSERT_TRUE(test::eventually([&] { return !client.fullResyncPending(); }));
+  for (const KeyFrameId id : taken) {
+    EXPECT_NE(std::find(on_their_way.begin(), on_their_way.end(), id), on_their_way.end())
+        << "keyframe " << id << " taken by the new session during its resync";
+  }
+  // Once the resync is applied, an upload the session took is no longer pending.
+  upload(5);
+  ASSERT_TRUE(client.flushUploads(10s));
+  EXPECT_TRUE(client.pendingUploadKeyFrames().empty());
 }
 
 TEST(EdgeResilience, CloseReturnsPromptly) {
