@@ -25,16 +25,6 @@ namespace {
 
 constexpr const char* kSequence = "datasets/7scenes-redkitchen-1000";
 
-// Relocalisation needs a vocabulary, and a fresh build has none (`make vocab` trains the default):
-// a small one, trained on other sequences than the one localised in, is written for the runs.
-std::string writeSmallVocabulary(const std::filesystem::path& folder) {
-  std::filesystem::create_directories(folder);
-  const auto path = folder / "small.vocab";
-  test::trainSmallVocabulary({{"datasets/tum-fr2desk-20", 1}, {"datasets/kitti07-160", 8}})
-      .save(path);
-  return path.string();
-}
-
 std::string fileBytes(const std::filesystem::path& path) {
   std::ifstream in(path, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
@@ -52,7 +42,7 @@ TEST(LocalizeOnly, FramesOfTheSecondHalfLocaliseInTheStoredMapAndFollowARouteOnI
   const auto mapping_out = test::freshTempDir("localize_mapping");
   const auto localize_out = test::freshTempDir("localize_run");
   const auto vocab_folder = test::freshTempDir("localize_vocab");
-  const std::string vocab = " --vocab " + writeSmallVocabulary(vocab_folder);
+  const std::string vocab = " --vocab " + test::writeSmallVocabulary(vocab_folder);
 
   const auto mapping = test::runEdgeslam(
       "run --dataset " + dataset + " --mode edge --sensor rgbd --maps " + store.string() +

@@ -38,14 +38,8 @@ std::filesystem::path tempDir(const std::string& name) {
 // relocalise (with `--vocab none` it could not, and under load it stayed lost for 300-400 frames).
 // A fresh build has no default vocabulary: a small one is trained on other sequences.
 const std::string& vocabularyPath() {
-  static const std::string path = [] {
-    const auto folder = test::freshTempDir("map_resync_vocab");
-    std::filesystem::create_directories(folder);
-    const auto file = folder / "small.vocab";
-    test::trainSmallVocabulary({{"datasets/tum-fr2desk-20", 1}, {"datasets/kitti07-160", 8}})
-        .save(file);
-    return file.string();
-  }();
+  static const std::string path =
+      test::writeSmallVocabulary(test::freshTempDir("map_resync_vocab"));
   return path;
 }
 

@@ -2,6 +2,7 @@
 // A small vocabulary (k=10, L=4) for tests, trained in seconds on every `step`-th frame of shared
 // sequences. Callers cache it (a function-local static) so a test process trains it once.
 #include <cstddef>
+#include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
@@ -31,6 +32,16 @@ inline Vocabulary trainSmallVocabulary(
   options.levels = 4;
   options.threads = 2;
   return trainVocabulary(descriptors, options);
+}
+
+// For runs of the binary, which need a vocabulary file (a fresh build has no default one): a small
+// vocabulary trained on TUM fr2desk and KITTI 07 (other sequences than the tests run on), written
+// as `folder`/small.vocab; returns its path.
+inline std::string writeSmallVocabulary(const std::filesystem::path& folder) {
+  std::filesystem::create_directories(folder);
+  const auto path = folder / "small.vocab";
+  trainSmallVocabulary({{"datasets/tum-fr2desk-20", 1}, {"datasets/kitti07-160", 8}}).save(path);
+  return path.string();
 }
 
 }  // namespace edgeslam::test
