@@ -72,8 +72,17 @@ nlohmann::json RouteFollowing::json(const Trajectory& ground_truth,
                                     const Trajectory& stored_keyframes, const Trajectory& localised,
                                     AlignMode align) const {
   const RouteRecord& route = navigator_->route();
-  std::size_t by_kind[7] = {};
-  for (const Entry& e : instructions_) ++by_kind[static_cast<int>(e.instruction.kind)];
+  nlohmann::json by_instruction = nlohmann::json::object();
+  for (InstructionKind kind :
+       {InstructionKind::kNoPose, InstructionKind::kGoStraight, InstructionKind::kTurnLeft,
+        InstructionKind::kTurnRight, InstructionKind::kCheckpointReached,
+        InstructionKind::kOffRoute, InstructionKind::kArrived}) {
+    by_instruction[toString(kind)] = 0;
+  }
+  for (const Entry& e : instructions_) {
+    by_instruction[toString(e.instruction.kind)] =
+        by_instruction[toString(e.instruction.kind)].get<int>() + 1;
+  }
   nlohmann::json out = {{"route", route.name},
                         {"map", map_},
                         {"source", route.source},
@@ -82,14 +91,7 @@ nlohmann::json RouteFollowing::json(const Trajectory& ground_truth,
                         {"reach_radius_m", navigator_->reachRadius()},
                         {"reached_by_estimate", navigator_->reached().size()},
                         {"arrived", navigator_->nextCheckpoint() >= route.checkpoints.size()},
-                        {"frames_by_instruction",
-                         {{"no_pose", by_kind[0]},
-                          {"straight", by_kind[1]},
-                          {"left", by_kind[2]},
-                          {"right", by_kind[3]},
-                          {"checkpoint", by_kind[4]},
-                          {"off_route", by_kind[5]},
-                          {"arrived", by_kind[6]}}}};
+                        {"frames_by_instruction", by_instruction}};
   if (ground_truth.empty()) return out;
   // The checkpoints into the truth's frame: by the stored keyframes of this stretch (independent
   // of how well this run localised), else by this run's poses.

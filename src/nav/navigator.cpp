@@ -97,7 +97,6 @@ double Navigator::distanceToRoute(const Eigen::Vector3d& position) const {
   for (std::size_t i = first; i < last; ++i) {
     best = std::min(best, distanceToSegment(position, points[i], points[i + 1]));
   }
-  if (first == last) best = (points[first] - position).norm();
   return best;
 }
 
