@@ -289,22 +289,22 @@ LinkTraffic EdgeSlam::linkTraffic() const {
 SlamCounters EdgeSlam::counters() const {
   const EdgeLinkCounters link = link_->counters();
   SlamCounters out;
-  out.uplink_bytes = link.uplink_bytes;
-  out.downlink_bytes = link.downlink_bytes;
-  out.uploads_dropped = link.uploads_dropped;
-  out.uploads_overflowed = link.uploads_overflowed;
-  out.keyframes_forgotten = sink_->keyFramesForgotten();
-  out.points_forgotten = sink_->pointsForgotten();
-  out.reconnects = link.reconnects;
-  out.keyframes_uploaded = sink_->uploadsSent();
-  out.uploads_unanswered = sink_->uploadsInFlight();
+  out.exchange.uplink_bytes = link.uplink_bytes;
+  out.exchange.downlink_bytes = link.downlink_bytes;
+  out.exchange.uploads_dropped = link.uploads_dropped;
+  out.exchange.uploads_overflowed = link.uploads_overflowed;
+  out.exchange.keyframes_forgotten = sink_->keyFramesForgotten();
+  out.exchange.points_forgotten = sink_->pointsForgotten();
+  out.exchange.reconnects = link.reconnects;
+  out.exchange.keyframes_uploaded = sink_->uploadsSent();
+  out.exchange.uploads_unanswered = sink_->uploadsInFlight();
   std::lock_guard lock(stats_mutex_);
-  out.slices_applied = slices_applied_;
-  out.loops = loops_;
-  out.slice_latency_ms = slice_latency_ms_.summary();
-  out.slice_apply_ms = slice_apply_ms_.summary();
-  out.keyframes_segmented = keyframes_segmented_;
-  out.segmentation_ms = segmentation_ms_.summary();
+  out.exchange.slices_applied = slices_applied_;
+  out.map.loops = loops_;
+  out.exchange.slice_latency_ms = slice_latency_ms_.summary();
+  out.exchange.slice_apply_ms = slice_apply_ms_.summary();
+  out.semantic.keyframes_segmented = keyframes_segmented_;
+  out.semantic.segmentation_ms = segmentation_ms_.summary();
   addClientCounters(out);
   return out;
 }

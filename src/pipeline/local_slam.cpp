@@ -62,12 +62,12 @@ void LocalSlam::refineIntrinsicsOfTheMap() {
 SlamCounters LocalSlam::counters() const {
   SlamCounters out;
   const MappingBackendCounters backend = backend_->counters();
-  out.loops = backend.loops;
+  out.map.loops = backend.loops;
   addClientCounters(out);
   if (backend_->segments()) {
-    out.keyframes_segmented = backend.keyframes_segmented;
-    out.segmentation_ms = backend.segmentation_ms;
-    out.movable_points_erased = backend.movable_points_erased;
+    out.semantic.keyframes_segmented = backend.keyframes_segmented;
+    out.semantic.segmentation_ms = backend.segmentation_ms;
+    out.semantic.movable_points_erased = backend.movable_points_erased;
   }
   return out;
 }

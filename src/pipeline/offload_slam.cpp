@@ -59,10 +59,10 @@ LinkTraffic OffloadSlam::linkTraffic() const {
 SlamCounters OffloadSlam::counters() const {
   const EdgeClientCounters c = client_->counters();
   SlamCounters out;
-  out.uplink_bytes = c.uplink_bytes;
-  out.downlink_bytes = c.downlink_bytes;
-  out.reconnects = c.reconnects;
-  out.edge_frame_ms = server_ms_.summary();
+  out.exchange.uplink_bytes = c.uplink_bytes;
+  out.exchange.downlink_bytes = c.downlink_bytes;
+  out.exchange.reconnects = c.reconnects;
+  out.exchange.edge_frame_ms = server_ms_.summary();
   return out;
 }
 

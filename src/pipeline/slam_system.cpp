@@ -113,16 +113,16 @@ TrackResult TrackingSlam::process(std::size_t frame_index, double timestamp, con
 }
 
 void TrackingSlam::addClientCounters(SlamCounters& counters) const {
-  counters.features_ms = features_ms_.summary();
-  counters.tracking_ms = tracking_ms_.summary();
-  counters.keyframe_ms = keyframe_ms_.summary();
+  counters.stages.features_ms = features_ms_.summary();
+  counters.stages.tracking_ms = tracking_ms_.summary();
+  counters.stages.keyframe_ms = keyframe_ms_.summary();
   if (paced_sink_) counters.backend = paced_sink_->pacing();
-  counters.keyframe_depth_ratio = keyFrameDepthRatio();
+  counters.map.keyframe_depth_ratio = keyFrameDepthRatio();
   if (!semantic_filter_) return;
   const SemanticFilterCounters c = semantic_filter_->counters();
-  counters.semantic_client_ms = semantic_ms_.summary();
-  counters.frames_with_mask = c.frames_with_mask;
-  counters.features_culled = c.features_culled;
+  counters.semantic.client_ms = semantic_ms_.summary();
+  counters.semantic.frames_with_mask = c.frames_with_mask;
+  counters.semantic.features_culled = c.features_culled;
 }
 
 Trajectory TrackingSlam::trajectoryAtFrameTime() const {

@@ -19,6 +19,7 @@
 #include "map/map.h"
 #include "optimize/map_optimization.h"
 #include "pipeline/paced_keyframe_sink.h"
+#include "pipeline/slam_counters.h"
 #include "pipeline/split_client_report.h"
 #include "place/vocabulary.h"
 #include "semantic/segmenter.h"
@@ -84,43 +85,6 @@ struct ClientStageTimes {
   double features_ms = 0.0;  // ORB extraction, undistortion, depth lookup (and semantic culling)
   double tracking_ms = 0.0;  // pose estimation and local-map tracking
   double keyframe_ms = 0.0;  // keyframe insertion, upload and the rest of the frame
-};
-
-// Network and edge figures; zero in local mode.
-struct SlamCounters {
-  std::uint64_t uplink_bytes = 0;
-  std::uint64_t downlink_bytes = 0;
-  std::uint64_t keyframes_uploaded = 0;
-  std::uint64_t uploads_dropped = 0;
-  std::uint64_t uploads_overflowed = 0;  // of those, pushed out of the link's full queue
-  // Sent, neither answered by a slice nor dropped when the run ended (a stalled link, a lost
-  // edge): the edge may or may not have them.
-  std::uint64_t uploads_unanswered = 0;
-  std::uint64_t keyframes_forgotten = 0;  // by the client, their upload dropped
-  std::uint64_t points_forgotten = 0;     // that went up with those uploads only
-  std::uint64_t slices_applied = 0;
-  std::uint64_t reconnects = 0;
-  std::uint64_t loops = 0;
-  PercentileSummary slice_latency_ms;
-  PercentileSummary slice_apply_ms;
-  PercentileSummary edge_frame_ms;  // offload: the edge's time per frame
-  // Semantic culling.
-  std::uint64_t keyframes_segmented = 0;
-  std::uint64_t movable_points_erased = 0;  // local mode (the edge erases its own)
-  PercentileSummary segmentation_ms;        // per keyframe, where it ran
-  PercentileSummary semantic_client_ms;     // mask transfer and culling per frame
-  std::uint64_t frames_with_mask = 0;
-  std::uint64_t features_culled = 0;
-  // Where the client's time per frame goes (modes that track on the client).
-  PercentileSummary features_ms;  // ORB extraction, undistortion, depth lookup
-  PercentileSummary tracking_ms;  // pose estimation and local-map tracking
-  PercentileSummary keyframe_ms;  // keyframe insertion, upload and the rest of the frame
-  // How long tracking waited for the back end, and how often the back end refused keyframes.
-  BackendPacing backend;
-  // Monocular: median scene depth of the last quarter of the keyframes over that of the first
-  // quarter (0 when there are too few keyframes). Along a drive the scene's depth stays about the
-  // same, so a map whose scale drifts shows it here (a cheap hint, no ground truth needed).
-  double keyframe_depth_ratio = 0.0;
 };
 
 // Bytes over the link so far (zero in local mode).

@@ -93,7 +93,7 @@ RunOutcome run(const PinholeCamera& camera, const std::vector<DatasetFrame>& fra
     if (r.state == TrackingState::kOk) ++out.tracked;
   }
   slam.finish();
-  out.loops = slam.counters().loops;
+  out.loops = slam.counters().map.loops;
   if (slam.loopCloser() != nullptr) out.stats = slam.loopCloser()->stats();
   const AteResult ate =
       computeAte(associateByTimestamp(ground_truth, slam.trajectoryFinal()),
@@ -200,10 +200,10 @@ TEST(LoopClosing, EdgeSessionClosesTheLoopFromTheSameBackendOptions) {
   ASSERT_NE(loop_closer, nullptr);
   std::printf("rgbd edge: %zu tracked, %zu loops on the edge, %llu reported to the client\n",
               tracked, loop_closer->loops(),
-              static_cast<unsigned long long>(edge.counters().loops));
+              static_cast<unsigned long long>(edge.counters().map.loops));
   EXPECT_GE(tracked, sequence.frames.size() * 85 / 100);
   EXPECT_GE(loop_closer->loops(), 1u);
-  EXPECT_EQ(edge.counters().loops, loop_closer->loops());
+  EXPECT_EQ(edge.counters().map.loops, loop_closer->loops());
   const RunOutcome local = run(sequence.camera, sequence.frames, Sensor::kRgbd, true, 100);
   EXPECT_GE(local.loops, 1u);
 }

@@ -1,0 +1,302 @@
+#include "run_report.h"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <fstream>
+
+#include "intrinsics_report.h"
+#include "map_store_option.h"
+#include "pipeline/adaptation_loop.h"
+#include "pipeline/run_warnings.h"
+#include "route_following.h"
+#include "run_metrics.h"
+#include "run_viewer.h"
+#include "semantic_evaluation.h"
+#include "tracking_diagnostics_json.h"
+
+namespace edgeslam::cli {
+
+RunReport::RunReport(const RunSetup& setup, const PlayedFrames& played, const SlamSystem& slam,
+                     const RunCompanions& companions, nlohmann::json store_metrics, double wall_s)
+    : setup_(setup),
+      played_(played),
+      slam_(slam),
+      companions_(companions),
+      store_metrics_(std::move(store_metrics)),
+      wall_s_(wall_s),
+      align_(setup.sensor == Sensor::kMonocular ? AlignMode::kSim3 : AlignMode::kSe3),
+      at_time_(slam.trajectoryAtFrameTime()),
+      final_(slam.trajectoryFinal()),
+      ate_(ateJson(played.ground_truth, at_time_, align_)),
+      ate_final_(ateJson(played.ground_truth, final_, align_)),
+      counters_(slam.counters()),
+      diagnostics_(slam.trackingDiagnostics()),
+      refinement_(slam.intrinsicsRefinement()) {
+  const RunOptions& options = setup.options;
+  warnings_ =
+      runWarnings({.frames = setup.frame_count,
+                   .tracked = played.tracked,
+                   .lost = played.lost,
+                   .frames_dropped_late = played.frames_skipped_late,
+                   .backend_busy_refusals = counters_.backend.busy_refusals,
+                   .backend_wait_ms = counters_.backend.wait_total_ms,
+                   .wall_ms = wall_s * 1000.0,
+                   .monocular = setup.sensor == Sensor::kMonocular,
+                   .keyframe_depth_ratio = counters_.map.keyframe_depth_ratio,
+                   .frames_out_of_order = played.frame_order.rejected(),
+                   .frames_without_map = diagnostics_ ? diagnostics_->frames_without_map : 0,
+                   .map_built = !diagnostics_ || diagnostics_->initialized_at_frame.has_value() ||
+                                options.localize_only,
+                   .refusals = diagnostics_ ? refusalSummary(*diagnostics_) : std::string()});
+  if (std::string store_warning = storeWarning(store_metrics_, slam.keyFrameCount());
+      !store_warning.empty()) {
+    warnings_.push_back(std::move(store_warning));
+  }
+  metrics_ = commonMetrics();
+  addModeMetrics();
+}
+
+nlohmann::json RunReport::commonMetrics() const {
+  const RunOptions& options = setup_.options;
+  const EdgeExchangeCounters& exchange = counters_.exchange;
+  const BackendPacing& backend = counters_.backend;
+  const FrameOrderGuard& order = played_.frame_order;
+  const std::size_t keyframes_uploaded = std::max<std::size_t>(1, exchange.keyframes_uploaded);
+  return {{"frames", setup_.frame_count},
+          {"tracked", played_.tracked},
+          {"lost", played_.lost},
+          {"keyframes", slam_.keyFrameCount()},
+          {"map_points", slam_.mapPointCount()},
+          {"client_ms", toJson(played_.client_ms.summary())},
+          {"e2e_ms", toJson(played_.e2e_ms.summary())},
+          {"uplink_bytes", exchange.uplink_bytes},
+          {"downlink_bytes", exchange.downlink_bytes},
+          {"bytes_per_keyframe", exchange.uplink_bytes / keyframes_uploaded},
+          {"keyframes_uploaded", exchange.keyframes_uploaded},
+          {"uploads_dropped", exchange.uploads_dropped},
+          {"uploads_overflowed", exchange.uploads_overflowed},
+          {"uploads_unanswered", exchange.uploads_unanswered},
+          {"keyframes_forgotten", exchange.keyframes_forgotten},
+          {"points_forgotten", exchange.points_forgotten},
+          {"slices_applied", exchange.slices_applied},
+          {"reconnects", exchange.reconnects},
+          {"slice_latency_ms", toJson(exchange.slice_latency_ms)},
+          {"slice_apply_ms", toJson(exchange.slice_apply_ms)},
+          {"segmentation_ms", toJson(counters_.semantic.segmentation_ms)},
+          {"loops", counters_.map.loops},
+          {"relocalizations", slam_.relocalizations()},
+          {"tracking_recoveries", slam_.trackingRecoveries()},
+          {"keyframe_decisions", keyFrameDecisionsJson(slam_.keyFrameDecisions())},
+          {"map_resets", slam_.mapResets()},
+          {"tracked_in_discarded_maps", played_.tracked_in_discarded_maps},
+          {"mode", options.mode},
+          {"requested_mode", options.mode},
+          {"sensor", setup_.sensor_name},
+          {"dataset", setup_.info.path.string()},
+          {"dataset_frames", frameRangeJson(options.frames, setup_.frame_count)},
+          {"wall_s", wall_s_},
+          {"pacing", options.realtime ? "realtime" : "fast"},
+          {"deterministic", options.deterministic},
+          {"localize_only", options.localize_only},
+          {"frames_dropped_late", played_.frames_skipped_late},
+          {"frames_skipped_late", played_.frames_skipped_late},
+          {"frames_processed", played_.frame_log.size()},
+          {"frames_read", played_.frames_read},
+          {"frames_read_unused", played_.frames_read_unused},
+          {"frames_out_of_order",
+           {{"skipped", order.rejected()},
+            {"duplicate_timestamp", order.duplicates()},
+            {"timestamp_backwards", order.backwards()},
+            {"timestamp_not_finite", order.notFinite()}}},
+          {"backend_waits", backend.waits},
+          {"backend_wait_ms",
+           {{"total", backend.wait_total_ms},
+            {"median", backend.wait_ms.median},
+            {"p90", backend.wait_ms.p90},
+            {"p95", backend.wait_ms.p95},
+            {"p99", backend.wait_ms.p99},
+            {"max", backend.wait_ms.max}}},
+          {"backend_busy_refusals", backend.busy_refusals},
+          {"keyframe_depth_ratio", counters_.map.keyframe_depth_ratio},
+          {"warnings", warnings_},
+          {"load_ms", toJson(played_.load_ms.summary())}};
+}
+
+void RunReport::addModeMetrics() {
+  const RunOptions& options = setup_.options;
+  nlohmann::json& metrics = metrics_;
+  if (diagnostics_) {
+    metrics["initialization"] = initializationJson(*diagnostics_);
+    metrics["lost_frames"] = lostFramesJson(*diagnostics_);
+  }
+  if (options.localize_only) {
+    // The frame (of this run) at which the first pose in the stored map was found.
+    const auto& log = played_.frame_log;
+    const auto first = std::find_if(log.begin(), log.end(), [](const auto& entry) {
+      return entry.state == TrackingState::kOk;
+    });
+    metrics["localization"] = {
+        {"map", options.map_name},
+        {"stored_keyframes", slam_.keyFrameCount()},
+        {"first_pose_frame", first == log.end() ? nlohmann::json() : nlohmann::json(first->index)}};
+  }
+  if (companions_.route) {
+    metrics["navigation"] =
+        companions_.route->json(played_.ground_truth, slam_.keyframeTrajectory(), at_time_, align_);
+  }
+  const ClientStageSummary& stages = counters_.stages;
+  if (stages.features_ms.count > 0) {
+    metrics["client_stages_ms"] = {{"features", toJson(stages.features_ms)},
+                                   {"tracking", toJson(stages.tracking_ms)},
+                                   {"keyframe", toJson(stages.keyframe_ms)}};
+  }
+  const EdgeExchangeCounters& exchange = counters_.exchange;
+  if (const AdaptationLoop* adaptation = slam_.adaptation()) {
+    metrics["adapt"] = adaptationJson(*adaptation);
+    // Probes share the channel: keep them out of the per-keyframe figure.
+    const std::uint64_t probe_bytes = adaptation->counters().probe_uplink_bytes;
+    metrics["bytes_per_keyframe"] =
+        (exchange.uplink_bytes - std::min<std::uint64_t>(exchange.uplink_bytes, probe_bytes)) /
+        std::max<std::uint64_t>(1, exchange.keyframes_uploaded);
+  }
+  if (const std::optional<SplitClientReport> split = slam_.splitClientReport()) {
+    addSplitClientMetrics(metrics, *split, counters_, options.client_map_keyframes);
+  }
+  if (options.semantic || companions_.semantic_eval) {
+    const SemanticCounters& s = counters_.semantic;
+    nlohmann::json semantic = {{"enabled", options.semantic},
+                               {"keyframes_segmented", s.keyframes_segmented},
+                               {"movable_points_erased", s.movable_points_erased},
+                               {"frames_with_mask", s.frames_with_mask},
+                               {"features_culled", s.features_culled},
+                               {"client_ms", toJson(s.client_ms)}};
+    if (companions_.semantic_eval) semantic.update(companions_.semantic_eval->json());
+    metrics["semantic"] = semantic;
+  }
+  if (ate_) metrics["ate"] = *ate_;
+  if (companions_.pass_log) {
+    metrics["repeat"] = options.repeat;
+    metrics["passes"] = companions_.pass_log->json(played_.ground_truth, at_time_, align_);
+  }
+  if (ate_final_) metrics["ate_final"] = *ate_final_;
+  if (!store_metrics_.is_null()) metrics["store"] = store_metrics_;
+  if (companions_.viewer) metrics["viewer_port"] = companions_.viewer->port();
+  if (refinement_) metrics["intrinsics_refinement"] = intrinsicsRefinementJson(*refinement_);
+}
+
+void RunReport::printSummary() const {
+  const RunOptions& options = setup_.options;
+  const std::size_t frame_count = setup_.frame_count;
+  const PercentileSummary client = played_.client_ms.summary();
+  fmt::print("\nSummary\n");
+  fmt::print("  dataset      {} ({})\n", setup_.info.path.string(), toString(setup_.info.format));
+  fmt::print("  mode/sensor  {} / {}\n", options.mode, setup_.sensor_name);
+  fmt::print(
+      "  frames       {} in {:.2f} s ({:.1f} fps), tracked {}, lost {}{}\n", frame_count, wall_s_,
+      static_cast<double>(frame_count) / std::max(wall_s_, 1e-9), played_.tracked, played_.lost,
+      played_.tracked_in_discarded_maps == 0 ? std::string()
+                                             : fmt::format(" ({} more tracked in a discarded map)",
+                                                           played_.tracked_in_discarded_maps));
+  fmt::print(
+      "  map          {} keyframes, {} points, {} relocalisations, {} recoveries, {} resets\n",
+      slam_.keyFrameCount(), slam_.mapPointCount(), slam_.relocalizations(),
+      slam_.trackingRecoveries(), slam_.mapResets());
+  if (diagnostics_ && diagnostics_->refusals != decltype(diagnostics_->refusals){}) {
+    const std::string refused = refusalSummary(*diagnostics_);
+    if (diagnostics_->initialized_at_frame) {
+      fmt::print("  map start    frame {}, {} frames without a map (refused: {})\n",
+                 *diagnostics_->initialized_at_frame, diagnostics_->frames_without_map, refused);
+    } else {
+      fmt::print("  map start    none (refused: {}; last: {})\n", refused,
+                 diagnostics_->last_refusal);
+    }
+  }
+  if (const std::optional<SplitClientReport> split = slam_.splitClientReport()) {
+    const ClientMapSize& c = split->client_map;
+    fmt::print("  client map   {} keyframes, {} points held (at most {} / {}; window {})\n",
+               c.keyframes, c.points, c.max_keyframes, c.max_points,
+               options.client_map_keyframes > 0 ? std::to_string(options.client_map_keyframes)
+                                                : std::string("unbounded"));
+  }
+  const EdgeExchangeCounters& exchange = counters_.exchange;
+  if (options.mode != "local") {
+    fmt::print(
+        "  edge         {} keyframes up, {} slices back, slice latency median {:.1f} ms p90 "
+        "{:.1f} ms, {} B up, {} B down\n",
+        exchange.keyframes_uploaded, exchange.slices_applied, exchange.slice_latency_ms.median,
+        exchange.slice_latency_ms.p90, exchange.uplink_bytes, exchange.downlink_bytes);
+  }
+  fmt::print("  client ms    median {:.2f}  p90 {:.2f}  p99 {:.2f}  max {:.2f}\n", client.median,
+             client.p90, client.p99, client.max);
+  const ClientStageSummary& stages = counters_.stages;
+  if (stages.features_ms.count > 0) {
+    fmt::print("  stages ms    features {:.2f}  tracking {:.2f}  keyframe {:.2f} (medians)\n",
+               stages.features_ms.median, stages.tracking_ms.median, stages.keyframe_ms.median);
+  }
+  if (options.semantic) {
+    const SemanticCounters& s = counters_.semantic;
+    fmt::print(
+        "  semantic     {} keyframes segmented ({:.0f} ms median), {} features culled, transfer "
+        "and culling {:.2f} ms median per frame\n",
+        s.keyframes_segmented, s.segmentation_ms.median, s.features_culled, s.client_ms.median);
+  }
+  if (companions_.semantic_eval) fmt::print("  {}\n", companions_.semantic_eval->summaryLine());
+  if (ate_) {
+    fmt::print("  ATE ({})    rmse {:.4f} m  ({} poses, at frame time)\n", toString(align_),
+               (*ate_)["rmse_m"].get<double>(), (*ate_)["pairs"].get<std::size_t>());
+  }
+  if (companions_.pass_log) companions_.pass_log->print();
+  if (ate_final_) {
+    fmt::print("  ATE final    rmse {:.4f} m  ({} poses, refined)\n",
+               (*ate_final_)["rmse_m"].get<double>(), (*ate_final_)["pairs"].get<std::size_t>());
+  }
+  if (companions_.route) printRouteSummary(metrics_["navigation"]);
+  if (refinement_) fmt::print("  intrinsics   {}\n", describe(*refinement_));
+  if (!store_metrics_.is_null() && store_metrics_.contains("bytes")) {
+    fmt::print(
+        "  map store    '{}' in {}: {} keyframes, {} points, {} B ({} B per keyframe), "
+        "write median {:.1f} ms per batch\n",
+        options.map_name, store_metrics_["location"].get<std::string>(),
+        store_metrics_["keyframes"].get<std::uint64_t>(),
+        store_metrics_["points"].get<std::uint64_t>(), store_metrics_["bytes"].get<std::uint64_t>(),
+        store_metrics_["bytes_per_keyframe"].get<std::uint64_t>(),
+        store_metrics_["write_ms"]["median"].get<double>());
+  }
+  const BackendPacing& backend = counters_.backend;
+  if (backend.waits > 0 || played_.frames_skipped_late > 0) {
+    fmt::print(
+        "  pacing       {}: waited for the back end {} times, {:.1f} s in all; {} frames "
+        "skipped late (the camera had a newer one)\n",
+        options.realtime ? "realtime" : "fast", backend.waits, backend.wait_total_ms / 1000.0,
+        played_.frames_skipped_late);
+  }
+  for (const std::string& warning : warnings_) fmt::print("  WARNING      {}\n", warning);
+}
+
+void RunReport::writeOutputs() const {
+  const std::filesystem::path& out_dir = setup_.options.out_dir;
+  if (out_dir.empty()) return;
+  std::filesystem::create_directories(out_dir);
+  writeTumTrajectory(out_dir / "trajectory.tum", at_time_);
+  writeTumTrajectory(out_dir / "trajectory_final.tum", final_);
+  writeTumTrajectory(out_dir / "keyframes.tum", slam_.keyframeTrajectory());
+  // For `edgeslam report`: the dataset's poses at the frames the run read.
+  if (!played_.ground_truth.empty()) {
+    writeTumTrajectory(out_dir / "groundtruth.tum", played_.ground_truth);
+  }
+  writeFrameLog(out_dir / "frames.csv", played_.frame_log);
+  if (companions_.route) companions_.route->writeInstructions(out_dir / "instructions.csv");
+  std::ofstream out(out_dir / "metrics.json");
+  out << metrics_.dump(2) << "\n";
+  spdlog::info("wrote trajectories, frames.csv and metrics.json to {}", out_dir.string());
+  if (refinement_) {
+    if (const auto camera_file = writeRefinedCamera(out_dir, *refinement_); !camera_file.empty()) {
+      spdlog::info("refined camera written to {} (--camera starts a run with it)",
+                   camera_file.string());
+    }
+  }
+}
+
+}  // namespace edgeslam::cli
