@@ -12,7 +12,7 @@
 #include <thread>
 
 #include "commands.h"
-#include "link/link_emulator.h"
+#include "linkem/link_emulator.h"
 
 namespace edgeslam::cli {
 namespace {

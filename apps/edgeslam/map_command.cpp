@@ -9,7 +9,7 @@
 #include <stdexcept>
 
 #include "commands.h"
-#include "edge/local_mapper.h"
+#include "mapping/local_mapper.h"
 #include "map/map.h"
 #include "map_store_option.h"
 #include "store/map_export.h"

@@ -4,8 +4,8 @@
 #include <CLI/CLI.hpp>
 #include <string>
 
-#include "net/edge_client.h"
-#include "net/edge_server.h"
+#include "wire/edge_client.h"
+#include "wire/edge_server.h"
 
 namespace edgeslam::cli {
 

@@ -8,7 +8,7 @@
 
 #include "eval/association.h"
 #include "eval/ate.h"
-#include "pipeline/slam_system.h"
+#include "modes/slam_system.h"
 #include "util/resident_memory.h"
 
 namespace edgeslam::cli {

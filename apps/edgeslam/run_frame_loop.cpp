@@ -8,7 +8,7 @@
 #include <string>
 
 #include "io/live_camera.h"
-#include "pipeline/adaptation_loop.h"
+#include "modes/adaptation_loop.h"
 #include "progress_line.h"
 #include "route_following.h"
 #include "run_viewer.h"
@@ -17,7 +17,7 @@
 namespace edgeslam::cli {
 namespace {
 
-// Test hook (tests/pipeline/live_camera_command_test.cpp): EDGESLAM_TEST_EXTRA_LOAD_MS makes each
+// Test hook (tests/modes/live_camera_command_test.cpp): EDGESLAM_TEST_EXTRA_LOAD_MS makes each
 // paced frame read that much slower, a device too slow for its camera.
 double testExtraLoadMs() {
   const char* value = std::getenv("EDGESLAM_TEST_EXTRA_LOAD_MS");

@@ -11,7 +11,7 @@
 #include "io/dataset.h"
 #include "io/frame_order_guard.h"
 #include "io/trajectory.h"
-#include "pipeline/slam_system.h"
+#include "modes/slam_system.h"
 #include "repeat_passes.h"
 #include "util/timing_stats.h"
 #include "viz/view_snapshot.h"

@@ -8,9 +8,9 @@
 #include "eval/alignment.h"
 #include "io/frame_range.h"
 #include "io/trajectory.h"
-#include "pipeline/adaptation_loop.h"
-#include "pipeline/slam_system.h"
-#include "pipeline/split_client_report.h"
+#include "modes/adaptation_loop.h"
+#include "modes/slam_system.h"
+#include "modes/split_client_report.h"
 #include "util/timing_stats.h"
 
 namespace edgeslam::cli {

@@ -7,7 +7,7 @@
 
 #include "io/frame_range.h"
 #include "network_security_options.h"
-#include "pipeline/slam_system.h"
+#include "modes/slam_system.h"
 
 namespace edgeslam::cli {
 

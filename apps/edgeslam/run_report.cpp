@@ -8,8 +8,8 @@
 
 #include "intrinsics_report.h"
 #include "map_store_option.h"
-#include "pipeline/adaptation_loop.h"
-#include "pipeline/run_warnings.h"
+#include "modes/adaptation_loop.h"
+#include "modes/run_warnings.h"
 #include "route_following.h"
 #include "run_metrics.h"
 #include "run_viewer.h"

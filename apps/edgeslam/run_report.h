@@ -10,7 +10,7 @@
 #include "io/dataset.h"
 #include "io/trajectory.h"
 #include "optimize/map_optimization.h"
-#include "pipeline/slam_system.h"
+#include "modes/slam_system.h"
 #include "run_frame_loop.h"
 #include "run_options.h"
 

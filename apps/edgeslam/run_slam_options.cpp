@@ -6,7 +6,7 @@
 #include <algorithm>
 #include <opencv2/core/utility.hpp>
 
-#include "edge/local_mapper.h"
+#include "mapping/local_mapper.h"
 #include "optimize/intrinsics_refinement.h"
 #include "segmenter_option.h"
 #include "vocabulary_option.h"

@@ -3,7 +3,7 @@
 // semantics, intrinsics refinement), after refusing the flags that apply to one mode only.
 #include "geometry/camera.h"
 #include "map/sensor.h"
-#include "pipeline/slam_system.h"
+#include "modes/slam_system.h"
 #include "run_options.h"
 
 namespace edgeslam::cli {

@@ -6,7 +6,7 @@
 #include <optional>
 #include <string>
 
-#include "pipeline/slam_system.h"
+#include "modes/slam_system.h"
 #include "viz/live_view.h"
 #include "viz/viewer_server.h"
 

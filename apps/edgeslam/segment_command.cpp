@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "commands.h"
-#include "net/image_header.h"
+#include "wire/image_header.h"
 #include "segment_truth_score.h"
 #include "semantic/coco_classes.h"
 #include "semantic/label_encoding.h"

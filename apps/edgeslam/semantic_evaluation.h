@@ -8,7 +8,7 @@
 #include <string>
 
 #include "client/tracking_types.h"
-#include "pipeline/slam_system.h"
+#include "modes/slam_system.h"
 #include "synth/ground_truth_masks.h"
 #include "util/timing_stats.h"
 

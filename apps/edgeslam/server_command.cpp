@@ -12,7 +12,7 @@
 #include "commands.h"
 #include "map_store_option.h"
 #include "network_security_options.h"
-#include "pipeline/slam_session_backend.h"
+#include "modes/slam_session_backend.h"
 #include "segmenter_option.h"
 #include "server_metrics.h"
 #include "server_viewer.h"

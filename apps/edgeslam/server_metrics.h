@@ -4,7 +4,7 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
-#include "net/edge_server.h"
+#include "wire/edge_server.h"
 
 namespace edgeslam {
 

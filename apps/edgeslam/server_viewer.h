@@ -5,7 +5,7 @@
 #include <memory>
 #include <string>
 
-#include "net/edge_server.h"
+#include "wire/edge_server.h"
 #include "viz/edge_view.h"
 #include "viz/viewer_server.h"
 

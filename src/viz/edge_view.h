@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "net/edge_server.h"
+#include "wire/edge_server.h"
 #include "viz/view_source.h"
 #include "viz/viewed_session_factory.h"
 

@@ -14,7 +14,7 @@
 #include <string>
 
 #include "geometry/se3.h"
-#include "pipeline/slam_system.h"
+#include "modes/slam_system.h"
 #include "viz/frame_image_slot.h"
 #include "viz/trajectory_decimator.h"
 #include "viz/view_snapshot.h"

@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "net/edge_server.h"
-#include "pipeline/slam_session_backend.h"
+#include "wire/edge_server.h"
+#include "modes/slam_session_backend.h"
 
 namespace edgeslam::viz {
 

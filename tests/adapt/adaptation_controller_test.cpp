@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <random>
 
-#include "link/link_settings.h"
+#include "linkem/link_settings.h"
 
 namespace edgeslam {
 namespace {

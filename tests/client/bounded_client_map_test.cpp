@@ -5,7 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "client/slice_applier.h"
-#include "edge/corridor_map.h"
+#include "mapping/corridor_map.h"
 #include "map/map_replication.h"
 
 namespace edgeslam {

@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "client/slice_applier.h"
-#include "edge/slice_builder.h"
+#include "server/slice_builder.h"
 #include "map/map_replication.h"
 #include "map/synthetic_views.h"
 

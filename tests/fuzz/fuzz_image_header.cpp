@@ -4,7 +4,7 @@
 #include <span>
 #include <string>
 
-#include "net/image_header.h"
+#include "wire/image_header.h"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   std::string error;

@@ -1,8 +1,8 @@
 // An uploaded keyframe: decoded, then its image header checked against a 640 x 480 camera.
 #include "fuzz_camera.h"
 #include "fuzz_wire_message.h"
-#include "net/received_image_check.h"
-#include "net/wire_convert.h"
+#include "wire/received_image_check.h"
+#include "wire/wire_convert.h"
 
 namespace {
 void decode(const edgeslam::v1::UploadKeyFrameRequest& request) {

@@ -1,6 +1,6 @@
 // A map slice, as the client decodes it from the edge's stream.
 #include "fuzz_wire_message.h"
-#include "net/wire_convert.h"
+#include "wire/wire_convert.h"
 
 namespace {
 void decode(const edgeslam::v1::MapSlice& slice) {

@@ -2,8 +2,8 @@
 // 640 x 480 camera (what the edge does before it decodes them).
 #include "fuzz_camera.h"
 #include "fuzz_wire_message.h"
-#include "net/received_image_check.h"
-#include "net/wire_convert.h"
+#include "wire/received_image_check.h"
+#include "wire/wire_convert.h"
 
 namespace {
 void decode(const edgeslam::v1::OffloadFrameRequest& request) {

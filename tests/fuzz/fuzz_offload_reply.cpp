@@ -1,6 +1,6 @@
 // The edge's answer to an offloaded frame, as the client decodes it.
 #include "fuzz_wire_message.h"
-#include "net/wire_convert.h"
+#include "wire/wire_convert.h"
 
 namespace {
 void decode(const edgeslam::v1::OffloadFrameReply& reply) {

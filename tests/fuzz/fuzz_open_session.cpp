@@ -1,6 +1,6 @@
 // A session request (camera, sensor, settings): the control message that sizes everything else.
 #include "fuzz_wire_message.h"
-#include "net/wire_convert.h"
+#include "wire/wire_convert.h"
 
 namespace {
 void decode(const edgeslam::v1::OpenSessionRequest& request) {

@@ -13,8 +13,8 @@
 #include <vector>
 
 #include "io/dataset.h"
-#include "net/net_test_records.h"
-#include "net/wire_convert.h"
+#include "wire/net_test_records.h"
+#include "wire/wire_convert.h"
 #include "place/vocabulary_training.h"
 #include "store/store_fixture.h"
 

@@ -12,10 +12,10 @@
 #include <memory>
 
 #include "edgeslam/v1/edgeslam.grpc.pb.h"
-#include "net/edge_server.h"
-#include "net/fake_edge_backend.h"
-#include "net/net_test_records.h"
-#include "net/wire_convert.h"
+#include "wire/edge_server.h"
+#include "wire/fake_edge_backend.h"
+#include "wire/net_test_records.h"
+#include "wire/wire_convert.h"
 
 namespace {
 

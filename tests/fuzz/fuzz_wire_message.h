@@ -5,7 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 
-#include "net/wire_error.h"
+#include "wire/wire_error.h"
 
 #define EDGESLAM_FUZZ_WIRE_MESSAGE(MessageType, decode)                               \
   extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) { \

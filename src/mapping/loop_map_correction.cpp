@@ -1,0 +1,66 @@
+#include "mapping/loop_map_correction.h"
+
+namespace edgeslam {
+
+Sim3d worldCorrection(const KeyFrameCorrection& correction) {
+  return correction.after.inverse() * correction.before;
+}
+
+MapCorrectionStats applyMapCorrection(Map& map, const MapCorrection& correction) {
+  MapCorrectionStats stats;
+  // Each keyframe's world correction, computed before anything moves.
+  std::unordered_map<const KeyFrame*, Sim3d> world_of;
+  for (const auto& [kf, c] : correction.keyframes) world_of.emplace(kf, worldCorrection(c));
+  const auto worldFor = [&](KeyFrame* kf) -> Sim3d {
+    std::vector<KeyFrame*> chain;
+    Sim3d found = Sim3d::identity();
+    for (KeyFrame* k = kf; k != nullptr; k = k->parent()) {
+      if (const auto it = world_of.find(k); it != world_of.end()) {
+        found = it->second;
+        break;
+      }
+      chain.push_back(k);
+      if (chain.size() > 1'000'000) break;  // a cycle would be a bug elsewhere; do not hang
+    }
+    for (KeyFrame* k : chain) world_of.emplace(k, found);
+    return found;
+  };
+
+  const std::vector<KeyFrame*> keyframes = map.keyFrames();
+  std::vector<std::pair<KeyFrame*, SE3d>> new_poses;
+  new_poses.reserve(keyframes.size());
+  for (KeyFrame* kf : keyframes) {
+    if (const auto it = correction.keyframes.find(kf); it != correction.keyframes.end()) {
+      new_poses.emplace_back(kf, it->second.after.toSE3());
+      ++stats.keyframes_moved;
+    } else {
+      new_poses.emplace_back(kf, (Sim3d(kf->pose()) * worldFor(kf).inverse()).toSE3());
+      ++stats.keyframes_propagated;
+    }
+  }
+  std::vector<std::pair<MapPoint*, Eigen::Vector3d>> new_positions;
+  for (MapPoint* p : map.mapPoints()) {
+    if (p->isBad()) continue;
+    if (const auto it = correction.point_positions.find(p);
+        it != correction.point_positions.end()) {
+      new_positions.emplace_back(p, it->second);
+      continue;
+    }
+    KeyFrame* anchor = p->referenceKeyFrame();
+    if (const auto it = correction.point_anchor.find(p); it != correction.point_anchor.end()) {
+      anchor = it->second;
+    }
+    if (anchor == nullptr) continue;
+    const Eigen::Vector3d moved = worldFor(anchor) * p->position();
+    if (moved != p->position()) new_positions.emplace_back(p, moved);
+  }
+  // Poses first: a point's viewing direction and distance range follow from the cameras.
+  for (const auto& [kf, pose] : new_poses) map.setKeyFramePose(kf, pose);
+  for (const auto& [p, position] : new_positions) {
+    map.relocatePoint(p, position);
+    ++stats.points_moved;
+  }
+  return stats;
+}
+
+}  // namespace edgeslam

@@ -1,0 +1,75 @@
+#include "modes/local_slam.h"
+
+#include <spdlog/spdlog.h>
+
+#include <stdexcept>
+
+namespace edgeslam {
+
+LocalSlam::LocalSlam(const PinholeCamera& camera, SlamOptions options)
+    : TrackingSlam(camera, std::move(options), 0) {
+  MappingBackendOptions backend = options_.backend;
+  if (options_.semantic) {
+    if (backend.segmenter == nullptr) {
+      throw std::invalid_argument("semantic culling in local mode needs a segmenter");
+    }
+  } else {
+    backend.segmenter = nullptr;
+  }
+  MappingBackendHooks hooks;
+  hooks.keyframe_segmented = [this](KeyFrameSegmentationResult result) {
+    semantic_filter_->offerMask(result.frame_index, std::move(result.labels));
+  };
+  backend_ = std::make_unique<MappingBackend>(map_, camera_, options_.sensor, std::move(backend),
+                                              std::move(hooks));
+  startTracking(backend_.get(), [this] { backend_->waitUntilKeyFramesMapped(); });
+  backend_->start();
+}
+
+LocalSlam::~LocalSlam() {
+  backend_->stop();
+}
+
+void LocalSlam::afterTracking(const TrackResult& result, std::size_t frame_index,
+                              const cv::Mat& image) {
+  if (!backend_->segments() || !result.new_keyframe || result.keyframe == kInvalidId) return;
+  backend_->segment({result.keyframe, frame_index, image.clone(),
+                     cv::Size(camera_.width(), camera_.height()), options_.keyframe_image_reduce});
+}
+
+void LocalSlam::afterFrame() {
+  backend_->processAll();  // unthreaded (--deterministic): the back end runs here
+  // Tracking on without a back end would report poses from a map nobody maintains.
+  if (auto cause = failure()) throw std::runtime_error(*cause);
+}
+
+std::optional<std::string> LocalSlam::failure() const {
+  return backend_->failure();
+}
+
+void LocalSlam::finish() {
+  backend_->waitUntilIdle();
+  if (options_.refine_intrinsics && !intrinsics_refinement_) refineIntrinsicsOfTheMap();
+}
+
+void LocalSlam::refineIntrinsicsOfTheMap() {
+  // The map is complete and the mapper idle: nothing else changes it while this runs.
+  spdlog::info("self-calibration over {} keyframes...", map_.keyFrameCount());
+  intrinsics_refinement_ = refineMapIntrinsics(map_, camera_, options_.intrinsics_refinement);
+  spdlog::info("intrinsics {}", describe(*intrinsics_refinement_));
+}
+
+SlamCounters LocalSlam::counters() const {
+  SlamCounters out;
+  const MappingBackendCounters backend = backend_->counters();
+  out.map.loops = backend.loops;
+  addClientCounters(out);
+  if (backend_->segments()) {
+    out.semantic.keyframes_segmented = backend.keyframes_segmented;
+    out.semantic.segmentation_ms = backend.segmentation_ms;
+    out.semantic.movable_points_erased = backend.movable_points_erased;
+  }
+  return out;
+}
+
+}  // namespace edgeslam

@@ -1,0 +1,33 @@
+#include "modes/paced_keyframe_sink.h"
+
+namespace edgeslam {
+
+PacedKeyFrameSink::PacedKeyFrameSink(KeyFrameSink& inner, std::function<void()> wait_until_idle)
+    : inner_(inner), wait_until_idle_(std::move(wait_until_idle)) {}
+
+void PacedKeyFrameSink::insertKeyFrame(KeyFrame* keyframe) {
+  if (wait_until_idle_) {
+    Stopwatch waited;
+    wait_until_idle_();
+    const double ms = waited.elapsedMs();
+    if (ms >= kWaitedMs) {
+      MutexLock lock(mutex_);
+      waits_ms_.add(ms);
+      wait_total_ms_ += ms;
+    }
+  }
+  inner_.insertKeyFrame(keyframe);
+}
+
+bool PacedKeyFrameSink::acceptsKeyFrames() const {
+  const bool accepts = inner_.acceptsKeyFrames();
+  if (!accepts) ++busy_refusals_;
+  return accepts;
+}
+
+BackendPacing PacedKeyFrameSink::pacing() const {
+  MutexLock lock(mutex_);
+  return {waits_ms_.count(), wait_total_ms_, waits_ms_.summary(), busy_refusals_.load()};
+}
+
+}  // namespace edgeslam

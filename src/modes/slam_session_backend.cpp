@@ -1,0 +1,287 @@
+#include "modes/slam_session_backend.h"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <opencv2/imgcodecs.hpp>
+#include <stdexcept>
+
+#include "modes/local_slam.h"
+#include "store/store_location.h"
+#include "store/stored_map_loader.h"
+#include "util/timing_stats.h"
+#include "wire/slice_splitting.h"
+#include "wire/wire_error.h"
+
+namespace edgeslam {
+namespace {
+
+// After a restart the edge's ids restart beyond the stored ones by this much: the last second of
+// ids before the restart (made, sent to the client, not stored) is never handed out again.
+constexpr std::uint64_t kEdgeIdGapAfterRestart = std::uint64_t{1} << 32;
+
+cv::Mat decodeImage(const std::vector<std::uint8_t>& bytes, int flags, const char* what) {
+  if (bytes.empty()) return {};
+  cv::Mat image = cv::imdecode(bytes, flags);
+  if (image.empty()) throw std::invalid_argument(std::string("undecodable ") + what + " image");
+  return image;
+}
+
+OffloadTrackingState toOffloadState(TrackingState state) {
+  switch (state) {
+    case TrackingState::kOk:
+      return OffloadTrackingState::kOk;
+    case TrackingState::kLost:
+      return OffloadTrackingState::kLost;
+    default:
+      return OffloadTrackingState::kNotInitialized;
+  }
+}
+
+}  // namespace
+
+SlamSessionBackend::SlamSessionBackend(const SessionConfig& config, SliceSink& sink,
+                                       SlamSessionOptions options)
+    : config_(config), sink_(sink), options_(options) {
+  if (config_.settings.semantic && options_.segmenter) {
+    try {
+      segmenter_ = makeSegmenter(*options_.segmenter);
+    } catch (const std::runtime_error& e) {
+      // A missing or broken model is the server's problem, but the session cannot be opened.
+      throw std::invalid_argument(std::string("no segmenter for this session: ") + e.what());
+    }
+  }
+  // A session naming a map the store holds resumes it (a client reconnecting after a restart):
+  // loaded now, so that the full resync the client asks for first carries it.
+  if (auto resumed = storedSessionToResume()) makeMapping(std::move(resumed));
+}
+
+SlamSessionBackend::~SlamSessionBackend() {
+  if (mapping_) mapping_->stop();
+  if (store_writer_) store_writer_->stop();
+  if (slices_split_.load() + slices_not_sent_.load() > 0) {
+    spdlog::info("session {}: {} slices split to fit a message, {} not sent", config_.session_id,
+                 slices_split_.load(), slices_not_sent_.load());
+  }
+}
+
+std::optional<StoredSession> SlamSessionBackend::storedSessionToResume() {
+  if (!options_.store || config_.map_name.empty() || config_.sensor == Sensor::kStereo) {
+    return std::nullopt;
+  }
+  std::optional<StoredMap> stored;
+  Stopwatch read_timer;
+  try {
+    stored = options_.store->loadMap(config_.map_name);
+  } catch (const std::exception& e) {
+    spdlog::error("session {}: map '{}' not loaded: {}", config_.session_id, config_.map_name,
+                  e.what());
+    return std::nullopt;
+  }
+  if (!stored) return std::nullopt;
+  StoredSession* latest = latestSessionWithKeyFrames(*stored);
+  if (latest == nullptr) return std::nullopt;
+  if (latest->info.sensor != config_.sensor) {
+    spdlog::warn("session {}: map '{}' was made with a {} sensor: not resumed by a {} session",
+                 config_.session_id, config_.map_name, toString(latest->info.sensor),
+                 toString(config_.sensor));
+    return std::nullopt;
+  }
+  spdlog::info("session {}: map '{}' read from {} in {:.0f} ms", config_.session_id,
+               config_.map_name, options_.store->location(), read_timer.elapsedMs());
+  return std::move(*latest);
+}
+
+void SlamSessionBackend::publish(MapSlice slice) {
+  try {
+    const SlicePushResult pushed = pushSplitting(sink_, std::move(slice));
+    if (pushed.parts > 1) {
+      ++slices_split_;
+      spdlog::info("session {}: slice sent in {} parts (larger than one message)",
+                   config_.session_id, pushed.parts);
+    }
+  } catch (const std::exception& e) {
+    ++slices_not_sent_;
+    spdlog::error("session {}: slice not sent ({} so far): {}", config_.session_id,
+                  slices_not_sent_.load(), e.what());
+  }
+}
+
+void SlamSessionBackend::makeMapping(std::optional<StoredSession> resumed) {
+  std::lock_guard view_lock(view_mutex_);
+  EdgeMapSessionOptions mapping = options_.mapping;
+  mapping.backend.mapper.observe_recent_points = true;
+  mapping.backend.segmenter = segmenter_;
+  // The client bounds its map: the window follows its setting.
+  mapping.window.keyframes =
+      static_cast<std::size_t>(std::max(0, config_.settings.client_map_keyframes));
+  double rebuild_ms = 0.0;
+  std::vector<KeyFrameId> stored_keyframes;
+  std::vector<KeyFrameId> places_missing;
+  std::size_t places_attached = 0;
+  if (resumed) {
+    mapping.preload = [&](Map& map) {
+      Stopwatch timer;
+      loadStoredSessionTakingFeatures(*resumed, map);
+      // Bags of words stored with the keyframes spare computing them again (~1.8 ms each).
+      const std::shared_ptr<const Vocabulary>& vocabulary = mapping.backend.mapper.vocabulary
+                                                                ? mapping.backend.mapper.vocabulary
+                                                                : mapping.backend.vocabulary;
+      if (vocabulary != nullptr && !vocabulary->empty()) {
+        AttachedPlaces places =
+            attachStoredPlaces(*resumed, map, *vocabulary, vocabulary->checksum(),
+                               mapping.backend.mapper.direct_index_depth);
+        places_attached = places.attached;
+        places_missing = std::move(places.missing);
+      }
+      // Edge ids made after the last batch the store kept may still name elements a client
+      // holds: new ones start well beyond.
+      std::uint64_t newest_edge_id = 0;
+      for (const KeyFrameRecord& k : resumed->keyframes) {
+        stored_keyframes.push_back(k.id);
+        if (idOrigin(k.id) == config_.id_origin) id_floor_ = std::max(id_floor_, k.id);
+      }
+      for (const MapPointRecord& p : resumed->points) {
+        if (idOrigin(p.id) == 0) newest_edge_id = std::max(newest_edge_id, p.id);
+        if (idOrigin(p.id) == config_.id_origin) id_floor_ = std::max(id_floor_, p.id);
+      }
+      map.ids().advancePast(newest_edge_id + kEdgeIdGapAfterRestart);
+      rebuild_ms = timer.elapsedMs();
+    };
+  }
+  mapping_ =
+      std::make_unique<EdgeMapSession>(config_.camera, config_.sensor, mapping,
+                                       [this](MapSlice slice) { publish(std::move(slice)); });
+  if (resumed) {
+    const EdgeMapSessionStats loaded = mapping_->stats();
+    const std::size_t keyframes = std::max<std::size_t>(1, loaded.keyframes_loaded);
+    spdlog::info(
+        "session {}: map '{}' resumed: {} keyframes, {} points; rebuilt in {:.0f} ms, bags of "
+        "words {:.0f} ms ({} stored, {} computed; {:.1f} ms per keyframe)",
+        config_.session_id, config_.map_name, loaded.keyframes_loaded, resumed->points.size(),
+        rebuild_ms, loaded.load_describe_ms, places_attached, places_missing.size(),
+        (rebuild_ms + loaded.load_describe_ms) / static_cast<double>(keyframes));
+  }
+  startStoreWriter(resumed ? std::optional<StoreSessionId>(resumed->id) : std::nullopt,
+                   stored_keyframes, places_missing);
+}
+
+void SlamSessionBackend::onKeyFrame(KeyFrameUpload upload) {
+  if (!mapping_) makeMapping(std::nullopt);
+  mapping_->onKeyFrame(upload);
+}
+
+void SlamSessionBackend::onFullResyncRequested() {
+  // A session with nothing mapped yet (no stored map to resume) answers with an empty map: the
+  // client then sends again every keyframe it holds.
+  if (!mapping_) makeMapping(std::nullopt);
+  mapping_->publishFullResync();
+}
+
+void SlamSessionBackend::startStoreWriter(std::optional<StoreSessionId> resumed,
+                                          const std::vector<KeyFrameId>& stored_keyframes,
+                                          const std::vector<KeyFrameId>& places_missing) {
+  if (!options_.store) return;
+  const std::string map =
+      !config_.map_name.empty()
+          ? config_.map_name
+          : defaultMapName(config_.client_name + "-s" + std::to_string(config_.session_id));
+  try {
+    StoreSessionId session = 0;
+    if (resumed) {
+      session = *resumed;
+      options_.store->resumeSession(session);
+    } else {
+      session =
+          options_.store->beginSession(map, {config_.client_name, config_.camera, config_.sensor});
+    }
+    store_writer_ = std::make_unique<MapStoreWriter>(options_.store, session, mapping_->map(),
+                                                     options_.store_stats);
+    store_writer_->assumeStored(stored_keyframes);
+    store_writer_->storePlacesOf(places_missing);
+    mapping_->setChangeObserver(store_writer_.get());
+    spdlog::info("session {}: writing map '{}' to {}{}", config_.session_id, map,
+                 options_.store->location(), resumed ? " (resumed)" : "");
+  } catch (const std::exception& e) {
+    // The session still maps; only its persistence is lost, and said so.
+    spdlog::error("session {}: map '{}' not stored: {}", config_.session_id, map, e.what());
+  }
+}
+
+std::optional<OffloadResult> SlamSessionBackend::onFrame(OffloadFrame frame) {
+  Stopwatch timer;
+  const cv::Mat gray = decodeImage(frame.image_bytes, cv::IMREAD_GRAYSCALE, "colour");
+  if (gray.empty()) throw std::invalid_argument("offloaded frame without an image");
+  cv::Mat depth;
+  if (config_.sensor != Sensor::kMonocular && !frame.depth_bytes.empty()) {
+    const cv::Mat raw = decodeImage(frame.depth_bytes, cv::IMREAD_UNCHANGED, "depth");
+    if (raw.type() != CV_16U) throw std::invalid_argument("offloaded depth must be 16-bit mm");
+    raw.convertTo(depth, CV_32F, 1.0 / 1000.0);
+  }
+  if (!offload_) {
+    std::lock_guard view_lock(view_mutex_);
+    SlamOptions slam_options = defaultSlamOptions(config_.camera, config_.sensor);
+    slam_options.orb.num_features = config_.settings.features;
+    slam_options.orb.num_levels = config_.settings.pyramid_levels;
+    slam_options.orb.scale_factor = config_.settings.scale_factor;
+    slam_options.semantic = segmenter_ != nullptr;
+    slam_options.backend.segmenter = segmenter_;
+    // Each frame's pose goes back as it is tracked; nothing would carry an end-of-session
+    // refinement to the client.
+    slam_options.refine_intrinsics = false;
+    offload_ = std::make_unique<LocalSlam>(config_.camera, slam_options);
+  }
+  const TrackResult tracked = offload_->process(frame.frame_index, frame.timestamp, gray, depth);
+  OffloadResult result;
+  result.frame_index = frame.frame_index;
+  result.state = toOffloadState(tracked.state);
+  result.T_cw = tracked.T_cw;
+  result.server_ms = timer.elapsedMs();
+  return result;
+}
+
+std::optional<std::string> SlamSessionBackend::failure() const {
+  std::lock_guard view_lock(view_mutex_);
+  if (offload_) return offload_->failure();
+  if (mapping_) return mapping_->failure();
+  return std::nullopt;
+}
+
+MapSample SlamSessionBackend::mapSample(std::size_t max_points) const {
+  std::lock_guard view_lock(view_mutex_);
+  if (offload_) return offload_->mapSample(max_points);
+  MapSample sample;
+  if (!mapping_) return sample;
+  const Map& map = mapping_->map();
+  std::lock_guard lock(map.updateMutex());
+  for (const KeyFrame* kf : map.keyFrames()) {
+    if (!kf->isBad()) sample.keyframe_poses.push_back(kf->poseInverse());
+  }
+  sample.points = map.pointPositionSample(max_points);
+  sample.total_points = map.pointCount();
+  return sample;
+}
+
+std::size_t SlamSessionBackend::loops() const {
+  std::lock_guard view_lock(view_mutex_);
+  if (mapping_ && mapping_->loopCloser() != nullptr) return mapping_->loopCloser()->loops();
+  return 0;
+}
+
+std::unique_ptr<EdgeSessionBackend> SlamSessionFactory::open(const SessionConfig& config,
+                                                             SliceSink& sink) {
+  if (config.sensor == Sensor::kStereo) {
+    throw std::invalid_argument("stereo sessions are not supported yet");
+  }
+  if (config.settings.semantic && !options_.segmenter) {
+    throw std::invalid_argument(
+        "the client asks for semantic culling and this edge server has no segmenter (start it "
+        "with --semantic on and the models)");
+  }
+  if (!config.map_name.empty()) checkMapName(config.map_name);
+  spdlog::info("edge: session {} for '{}' ({}x{}, {})", config.session_id, config.client_name,
+               config.camera.width(), config.camera.height(), toString(config.sensor));
+  return std::make_unique<SlamSessionBackend>(config, sink, options_);
+}
+
+}  // namespace edgeslam

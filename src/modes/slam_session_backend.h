@@ -1,0 +1,78 @@
+#pragma once
+// What an edge server session does: in edge mode it keeps the client's global map (keyframe
+// uploads in, map slices out); in offload mode it runs the whole SLAM on the frames it is sent.
+#include <atomic>
+#include <memory>
+#include <mutex>
+#include <optional>
+
+#include "modes/local_slam.h"
+#include "modes/slam_system.h"
+#include "server/edge_map_session.h"
+#include "store/map_store_writer.h"
+#include "wire/edge_server.h"
+
+namespace edgeslam {
+
+struct SlamSessionOptions {
+  EdgeMapSessionOptions mapping;
+  // Sessions that ask for semantic culling get a segmenter made with these; without, such a
+  // session is refused.
+  std::optional<SegmenterOptions> segmenter;
+  // Edge sessions write their map here as it changes (nullptr = kept in memory only), into the
+  // map the client names or a new one; what the writers did is added to store_stats.
+  std::shared_ptr<MapStore> store;
+  std::shared_ptr<MapStoreWriteStats> store_stats;
+};
+
+class SlamSessionBackend : public EdgeSessionBackend {
+ public:
+  SlamSessionBackend(const SessionConfig& config, SliceSink& sink, SlamSessionOptions options);
+  ~SlamSessionBackend() override;
+
+  void onKeyFrame(KeyFrameUpload upload) override;
+  std::optional<OffloadResult> onFrame(OffloadFrame frame) override;
+  // Edge mode: a slice with full_resync (every keyframe's pose and every point), split when
+  // larger than a message.
+  void onFullResyncRequested() override;
+  std::uint64_t idFloor() const override { return id_floor_; }
+  std::optional<std::string> failure() const override;
+
+  // For a viewer, from any thread: the session's map now (its global map in edge mode, the
+  // offloaded SLAM's map in offload mode; empty before the first keyframe or frame) and the loops
+  // it closed.
+  MapSample mapSample(std::size_t max_points) const;
+  std::size_t loops() const;
+
+ private:
+  // The map's latest stored session with keyframes, when the session names a stored map.
+  std::optional<StoredSession> storedSessionToResume();
+  void makeMapping(std::optional<StoredSession> resumed);
+  void startStoreWriter(std::optional<StoreSessionId> resumed,
+                        const std::vector<KeyFrameId>& stored_keyframes,
+                        const std::vector<KeyFrameId>& places_missing);
+  void publish(MapSlice slice);
+
+  mutable std::mutex view_mutex_;  // guards making mapping_ and offload_, for the viewer
+  SessionConfig config_;
+  SliceSink& sink_;
+  SlamSessionOptions options_;
+  std::shared_ptr<Segmenter> segmenter_;          // when the session asked for semantic culling
+  std::unique_ptr<MapStoreWriter> store_writer_;  // outlives mapping_, which it observes
+  std::unique_ptr<EdgeMapSession> mapping_;       // edge mode, made at the first keyframe
+  std::unique_ptr<LocalSlam> offload_;            // offload mode, made at the first frame
+  std::uint64_t id_floor_ = 0;
+  std::atomic<std::uint64_t> slices_split_{0};     // slices sent as several parts
+  std::atomic<std::uint64_t> slices_not_sent_{0};  // slices that could not be sent (logged)
+};
+
+class SlamSessionFactory : public EdgeSessionFactory {
+ public:
+  explicit SlamSessionFactory(SlamSessionOptions options = {}) : options_(options) {}
+  std::unique_ptr<EdgeSessionBackend> open(const SessionConfig& config, SliceSink& sink) override;
+
+ private:
+  SlamSessionOptions options_;
+};
+
+}  // namespace edgeslam
