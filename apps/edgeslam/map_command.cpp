@@ -9,9 +9,9 @@
 #include <stdexcept>
 
 #include "commands.h"
-#include "mapping/local_mapper.h"
 #include "map/map.h"
 #include "map_store_option.h"
+#include "mapping/local_mapper.h"
 #include "store/map_export.h"
 #include "store/store_error.h"
 #include "store/stored_map_loader.h"

@@ -67,13 +67,14 @@ void addSplitClientMetrics(nlohmann::json& metrics, const SplitClientReport& spl
   // Every keyframe the client made is on the edge, culled there as redundant, on its way, or
   // lost for a reason below.
   const ResyncCounters& r = split.resync;
-  metrics["resync"] = {{"full_resyncs", r.full_resyncs},
-                       {"keyframes_made", counters.exchange.keyframes_uploaded - r.keyframes_resent},
-                       {"keyframes_resent", r.keyframes_resent},
-                       {"keyframes_culled_by_edge", r.keyframes_culled_by_edge},
-                       {"keyframes_lost",
-                        {{"upload_dropped", counters.exchange.keyframes_forgotten},
-                         {"evicted_before_stored", r.keyframes_lost_evicted}}}};
+  metrics["resync"] = {
+      {"full_resyncs", r.full_resyncs},
+      {"keyframes_made", counters.exchange.keyframes_uploaded - r.keyframes_resent},
+      {"keyframes_resent", r.keyframes_resent},
+      {"keyframes_culled_by_edge", r.keyframes_culled_by_edge},
+      {"keyframes_lost",
+       {{"upload_dropped", counters.exchange.keyframes_forgotten},
+        {"evicted_before_stored", r.keyframes_lost_evicted}}}};
   const KeyFrameTriangulationStats& t = split.triangulation;
   if (t.keyframes > 0) {
     const PercentileSummary ms = t.ms.summary();

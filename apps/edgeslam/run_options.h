@@ -6,8 +6,8 @@
 #include <string>
 
 #include "io/frame_range.h"
-#include "network_security_options.h"
 #include "modes/slam_system.h"
+#include "network_security_options.h"
 
 namespace edgeslam::cli {
 

@@ -9,8 +9,8 @@
 #include "eval/alignment.h"
 #include "io/dataset.h"
 #include "io/trajectory.h"
-#include "optimize/map_optimization.h"
 #include "modes/slam_system.h"
+#include "optimize/map_optimization.h"
 #include "run_frame_loop.h"
 #include "run_options.h"
 

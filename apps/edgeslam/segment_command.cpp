@@ -13,13 +13,13 @@
 #include <vector>
 
 #include "commands.h"
-#include "wire/image_header.h"
 #include "segment_truth_score.h"
 #include "semantic/coco_classes.h"
 #include "semantic/label_encoding.h"
 #include "semantic/segmentation_overlay.h"
 #include "semantic/segmenter.h"
 #include "util/timing_stats.h"
+#include "wire/image_header.h"
 
 namespace edgeslam::cli {
 namespace {

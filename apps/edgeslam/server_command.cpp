@@ -11,8 +11,8 @@
 
 #include "commands.h"
 #include "map_store_option.h"
-#include "network_security_options.h"
 #include "modes/slam_session_backend.h"
+#include "network_security_options.h"
 #include "segmenter_option.h"
 #include "server_metrics.h"
 #include "server_viewer.h"

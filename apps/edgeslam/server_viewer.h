@@ -5,9 +5,9 @@
 #include <memory>
 #include <string>
 
-#include "wire/edge_server.h"
 #include "viz/edge_view.h"
 #include "viz/viewer_server.h"
+#include "wire/edge_server.h"
 
 namespace edgeslam::cli {
 

@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
-#include "wire/edge_server.h"
 #include "viz/view_source.h"
 #include "viz/viewed_session_factory.h"
+#include "wire/edge_server.h"
 
 namespace edgeslam::viz {
 

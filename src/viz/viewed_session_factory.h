@@ -11,8 +11,8 @@
 #include <string>
 #include <vector>
 
-#include "wire/edge_server.h"
 #include "modes/slam_session_backend.h"
+#include "wire/edge_server.h"
 
 namespace edgeslam::viz {
 

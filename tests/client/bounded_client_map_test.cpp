@@ -5,8 +5,8 @@
 #include <gtest/gtest.h>
 
 #include "client/slice_applier.h"
-#include "mapping/corridor_map.h"
 #include "map/map_replication.h"
+#include "mapping/corridor_map.h"
 
 namespace edgeslam {
 namespace {

@@ -3,9 +3,9 @@
 #include <gtest/gtest.h>
 
 #include "client/slice_applier.h"
-#include "server/slice_builder.h"
 #include "map/map_replication.h"
 #include "map/synthetic_views.h"
+#include "server/slice_builder.h"
 
 namespace edgeslam {
 namespace {

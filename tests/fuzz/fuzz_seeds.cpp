@@ -13,10 +13,10 @@
 #include <vector>
 
 #include "io/dataset.h"
-#include "wire/net_test_records.h"
-#include "wire/wire_convert.h"
 #include "place/vocabulary_training.h"
 #include "store/store_fixture.h"
+#include "wire/net_test_records.h"
+#include "wire/wire_convert.h"
 
 namespace fs = std::filesystem;
 using namespace edgeslam;
