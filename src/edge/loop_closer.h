@@ -20,6 +20,7 @@
 #include "edge/loop_verifier.h"
 #include "geometry/camera.h"
 #include "map/map.h"
+#include "map/map_participant.h"
 #include "map/sensor.h"
 #include "place/vocabulary.h"
 #include "util/mutex.h"
