@@ -153,25 +153,27 @@ TEST(MapBulkLoad, LinksTheGraphUpdateConnectionsLinksKeyFrameByKeyFrame) {
   expectSameMaps(one_by_one, bulk);
 }
 
+// Keyframes, then every planned point but the last, one call at a time.
+void addPlannedPoints(Map& map, const std::vector<PointPlan>& points) REQUIRES(map.updateMutex()) {
+  const auto keyframes = addKeyFrames(map);
+  for (std::size_t i = 0; i + 1 < points.size(); ++i) {
+    const PointPlan& p = points[i];
+    MapPoint* point = map.createMapPoint(Eigen::Vector3d(0, 0, 1), keyframes[p.keyframes[0]],
+                                         static_cast<MapPointId>(1000 + i));
+    for (std::size_t j = 0; j < p.keyframes.size(); ++j) {
+      map.addObservation(point, keyframes[p.keyframes[j]], p.keypoints[j]);
+    }
+  }
+}
+
 TEST(MapBulkLoad, UpdatesLinksThatAreThereAlready) {
   const std::vector<PointPlan> points = plan();
   Map once;
   Map twice;
   MutexLock lock_a(once.updateMutex());
   MutexLock lock_b(twice.updateMutex());
-  const auto add_points = [&](Map& map) REQUIRES(map.updateMutex()) {
-    const auto keyframes = addKeyFrames(map);
-    for (std::size_t i = 0; i + 1 < points.size(); ++i) {
-      const PointPlan& p = points[i];
-      MapPoint* point = map.createMapPoint(Eigen::Vector3d(0, 0, 1), keyframes[p.keyframes[0]],
-                                           static_cast<MapPointId>(1000 + i));
-      for (std::size_t j = 0; j < p.keyframes.size(); ++j) {
-        map.addObservation(point, keyframes[p.keyframes[j]], p.keypoints[j]);
-      }
-    }
-  };
-  add_points(once);
-  add_points(twice);
+  addPlannedPoints(once, points);
+  addPlannedPoints(twice, points);
   for (KeyFrame* keyframe : once.keyFrames()) once.updateConnections(keyframe);
   for (KeyFrame* keyframe : once.keyFrames()) once.updateConnections(keyframe);
   twice.linkAllConnections();
