@@ -130,6 +130,7 @@ int mapInfo(const MapCommandOptions& o) {
         places_computed += describeKeyFrames(map, *vocabulary, depth);
         places_ms += places_timer.elapsedMs();
       }
+      MutexLock lock(map.updateMutex());
       keyframes += map.keyFrameCount();
       points += map.pointCount();
     }

@@ -19,7 +19,7 @@ void EdgeKeyFrameSink::insertKeyFrame(KeyFrame* keyframe) {
 bool EdgeKeyFrameSink::resendKeyFrame(KeyFrameId id) {
   KeyFrame* keyframe = nullptr;
   {
-    std::lock_guard lock(map_.updateMutex());
+    MutexLock lock(map_.updateMutex());
     keyframe = map_.keyFrame(id);
     if (keyframe == nullptr || keyframe->isBad() || keyframe->isEvicted()) return false;
   }
@@ -31,7 +31,7 @@ bool EdgeKeyFrameSink::resendKeyFrame(KeyFrameId id) {
 void EdgeKeyFrameSink::sendUpload(KeyFrame* keyframe, bool resend) {
   KeyFrameUpload upload;
   {
-    std::lock_guard lock(map_.updateMutex());
+    MutexLock lock(map_.updateMutex());
     if (keyframe->isBad()) return;
     upload.keyframe = keyFrameRecord(*keyframe);
     const std::uint8_t own_origin = idOrigin(keyframe->id());
@@ -48,8 +48,9 @@ void EdgeKeyFrameSink::sendUpload(KeyFrame* keyframe, bool resend) {
     // Points the map has erased since cannot be uploaded again: forgotten a few thousand at a time,
     // so that what a long session remembers follows what its map holds.
     if (uploaded_points_.size() > 2 * map_.pointCount() + kForgetUploadedPointsEvery) {
-      std::erase_if(uploaded_points_,
-                    [this](MapPointId id) { return map_.mapPoint(id) == nullptr; });
+      std::erase_if(uploaded_points_, [this](MapPointId id) REQUIRES(map_.updateMutex()) {
+        return map_.mapPoint(id) == nullptr;
+      });
     }
     upload.segmenter_nms = segmenter_nms_.load();
     if (!resend) {
@@ -104,7 +105,7 @@ bool EdgeKeyFrameSink::acceptsUrgentKeyFrames() const {
 }
 
 void EdgeKeyFrameSink::onMapReset() {
-  std::lock_guard lock(map_.updateMutex());
+  MutexLock lock(map_.updateMutex());
   reset_pending_ = true;
   uploaded_points_.clear();
   recent_uploads_.clear();  // the map they were made in is gone: nothing to forget
@@ -134,7 +135,7 @@ bool EdgeKeyFrameSink::onUploadDropped(std::uint64_t upload_sequence, KeyFrameId
     std::lock_guard lock(sent_mutex_);
     if (upload_sequence > answered_.load()) dropped_unanswered_.insert(upload_sequence);
   }
-  std::lock_guard lock(map_.updateMutex());
+  MutexLock lock(map_.updateMutex());
   KeyFrame* keyframe = map_.keyFrame(keyframe_id);
   std::vector<MapPointId> unknown_points;
   const auto record =

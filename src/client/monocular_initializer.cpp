@@ -68,7 +68,7 @@ KeyFrame* MonocularInitializer::tryInitialize(Frame& frame, Map& map) {
   KeyFrame* kf0 = nullptr;
   KeyFrame* kf1 = nullptr;
   {
-    std::lock_guard lock(map.updateMutex());
+    MutexLock lock(map.updateMutex());
     kf0 =
         map.createKeyFrame(reference_->index, reference_->timestamp, reference_->features, SE3d());
     kf1 = map.createKeyFrame(frame.index, frame.timestamp, frame.features,
@@ -86,7 +86,7 @@ KeyFrame* MonocularInitializer::tryInitialize(Frame& frame, Map& map) {
 
   globalBundleAdjustment(map, camera_, nullptr, 20);
 
-  std::lock_guard lock(map.updateMutex());
+  MutexLock lock(map.updateMutex());
   const double median_depth = kf0->medianSceneDepth();
   const int tracked = kf1->trackedPointCount(1);
   if (median_depth <= 0.0 || tracked < options_.min_map_points) {

@@ -34,7 +34,7 @@ class MonocularInitializer {
 
   // Tries to initialise from `frame`; on success the map holds two keyframes and `frame` has its
   // pose and point matches set. Returns the second keyframe (the current frame's) or nullptr.
-  KeyFrame* tryInitialize(Frame& frame, Map& map);
+  KeyFrame* tryInitialize(Frame& frame, Map& map) EXCLUDES(map.updateMutex());
   const std::string& lastFailure() const { return last_failure_; }
   // Why the last call built no map; nullopt when it only waited (a new reference frame).
   std::optional<InitRefusal> lastRefusal() const { return last_refusal_; }

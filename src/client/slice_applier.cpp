@@ -19,7 +19,8 @@ namespace {
 std::size_t carryNewerKeyFrames(Map& map, const MapSlice& slice, const SE3d& anchor_before,
                                 const SE3d& anchor_after,
                                 const std::unordered_set<MapPointId>& points_in_slice,
-                                const std::unordered_set<KeyFrameId>& keyframes_in_slice) {
+                                const std::unordered_set<KeyFrameId>& keyframes_in_slice)
+    REQUIRES(map.updateMutex()) {
   const KeyFrameId anchor = slice.processed_keyframe;
   const SE3d world_correction = anchor_after.inverse() * anchor_before;  // old world -> new world
   const SE3d pose_correction = anchor_before.inverse() * anchor_after;   // T_cw' = T_cw * this
@@ -47,7 +48,7 @@ std::size_t carryNewerKeyFrames(Map& map, const MapSlice& slice, const SE3d& anc
 
 SliceApplyResult applySlice(Map& map, const MapSlice& slice, const PinholeCamera& camera) {
   SliceApplyResult result;
-  std::lock_guard lock(map.updateMutex());
+  MutexLock lock(map.updateMutex());
   map.setChangeRecording(false);
   // Before the slice's erasures: a keyframe the edge culled as soon as it had mapped it (a
   // revisit) still tells how far mapping has come.

@@ -38,6 +38,7 @@ struct SliceApplyResult {
   std::vector<KeyFrameId> keyframes_edge_lacks;
 };
 
-SliceApplyResult applySlice(Map& map, const MapSlice& slice, const PinholeCamera& camera);
+SliceApplyResult applySlice(Map& map, const MapSlice& slice, const PinholeCamera& camera)
+    EXCLUDES(map.updateMutex());
 
 }  // namespace edgeslam

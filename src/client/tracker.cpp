@@ -64,7 +64,7 @@ void Tracker::localizeInMap() {
   if (!places_) {
     throw std::invalid_argument("localisation in a stored map needs a vocabulary");
   }
-  std::lock_guard lock(map_.updateMutex());
+  MutexLock lock(map_.updateMutex());
   std::size_t filed = 0;
   for (KeyFrame* keyframe : map_.keyFrames()) {
     if (keyframe->isBad() || keyframe->isEvicted()) continue;
@@ -77,7 +77,7 @@ void Tracker::localizeInMap() {
 
 void Tracker::onMapWindowChanged(const std::vector<KeyFrameId>& evicted,
                                  const std::vector<KeyFrameId>& entered) {
-  std::lock_guard lock(map_.updateMutex());
+  MutexLock lock(map_.updateMutex());
   if (!places_) return;
   for (KeyFrameId id : evicted) places_->erase(id);
   for (KeyFrameId id : entered) {
@@ -87,7 +87,7 @@ void Tracker::onMapWindowChanged(const std::vector<KeyFrameId>& evicted,
 }
 
 std::size_t Tracker::placesSize() const {
-  std::lock_guard lock(map_.updateMutex());
+  MutexLock lock(map_.updateMutex());
   return places_ ? places_->size() : 0;
 }
 
@@ -120,7 +120,7 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
   bool ok = false;
   bool recovered = false;  // by the motion prediction, after some lost frames
   {
-    std::lock_guard lock(map_.updateMutex());
+    MutexLock lock(map_.updateMutex());
     releaseErased();
     if (last_frame_ && last_frame_->T_cw) {
       // The last frame's keyframe may have moved since (local BA): follow it.
@@ -209,7 +209,7 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
       !options_.localization_only) {
     std::size_t keyframes = 0;
     {
-      std::lock_guard lock(map_.updateMutex());
+      MutexLock lock(map_.updateMutex());
       keyframes = map_.keyFrameCount();
     }
     if (keyframes <= 5) {
@@ -245,7 +245,7 @@ bool Tracker::initialize(Frame& frame) {
   }
   KeyFrame* kf0 = nullptr;
   {
-    std::lock_guard lock(map_.updateMutex());
+    MutexLock lock(map_.updateMutex());
     kf0 = map_.originKeyFrame();
     spdlog::info("monocular map initialised at frame {} with {} points (reference frame {})",
                  frame.index, map_.pointCount(), kf0->frameIndex());
@@ -281,7 +281,7 @@ bool Tracker::initializeRgbd(Frame& frame) {
   }
   KeyFrame* kf = nullptr;
   {
-    std::lock_guard lock(map_.updateMutex());
+    MutexLock lock(map_.updateMutex());
     frame.T_cw = SE3d();
     kf = map_.createKeyFrame(frame.index, frame.timestamp, frame.features, SE3d());
     const FrameFeatures& f = *frame.features;
@@ -689,13 +689,14 @@ void Tracker::releaseErased() {
   // Erased keyframes leave the relocalisation database a few dozen at a time.
   constexpr std::size_t kForgetEvery = 32;
   if (places_ && places_->size() > map_.heldKeyFrameCount() + kForgetEvery) {
-    places_->forgetIf([this](KeyFrameId id) { return map_.keyFrame(id) == nullptr; });
+    places_->forgetIf([this](KeyFrameId id)
+                          REQUIRES(map_.updateMutex()) { return map_.keyFrame(id) == nullptr; });
   }
-  map_participant_.quiescent();
+  map_participant_.quiescent(map_);
 }
 
 void Tracker::resetMap() {
-  std::lock_guard lock(map_.updateMutex());
+  MutexLock lock(map_.updateMutex());
   map_.clear();
   if (places_) places_->clear();
   for (FrameRecord& r : records_) {
@@ -710,7 +711,7 @@ void Tracker::resetMap() {
   local_points_.clear();
   frames_lost_ = 0;
   ++resets_;
-  map_participant_.quiescent();  // nothing of the old map is held any more
+  map_participant_.quiescent(map_);  // nothing of the old map is held any more
 }
 
 }  // namespace edgeslam

@@ -17,6 +17,7 @@
 #include "geometry/camera.h"
 #include "map/frame.h"
 #include "map/map.h"
+#include "map/map_participant.h"
 #include "map/pair_triangulation.h"
 #include "util/timing_stats.h"
 
@@ -131,22 +132,22 @@ class Tracker {
   bool trackWithMotionModel(Frame& frame, std::size_t steps = 1);
   bool trackReferenceKeyFrame(Frame& frame);
   bool canRecoverByPrediction(std::size_t frame_index) const;
-  bool relocalize(Frame& frame);
-  std::vector<KeyFrame*> relocalizationCandidates(const Frame& frame);
+  bool relocalize(Frame& frame) REQUIRES(map_.updateMutex());
+  std::vector<KeyFrame*> relocalizationCandidates(const Frame& frame) REQUIRES(map_.updateMutex());
   int matchForRelocalization(KeyFrame& candidate, Frame& frame);
   void remember(KeyFrame* keyframe);
   int trackLocalMap(Frame& frame);
   void updateLocalMap(const Frame& frame);
   void addPointsFromLastFrameDepth(Frame& last);
   int discardOutliers(Frame& frame);
-  KeyFrameDecision decide(const Frame& frame, int inliers) const;
-  KeyFrame* createKeyFrame(Frame& frame);
-  void triangulateAtKeyFrame(KeyFrame* keyframe, Frame& frame);
+  KeyFrameDecision decide(const Frame& frame, int inliers) const REQUIRES(map_.updateMutex());
+  KeyFrame* createKeyFrame(Frame& frame) REQUIRES(map_.updateMutex());
+  void triangulateAtKeyFrame(KeyFrame* keyframe, Frame& frame) REQUIRES(map_.updateMutex());
   void record(const Frame& frame, bool tracked);
   void resetMap();
   // Under the map's mutex, at the start of each frame: lets go of erased points and keyframes so
   // that the map can free them (MapParticipant).
-  void releaseErased();
+  void releaseErased() REQUIRES(map_.updateMutex());
   void reportFeaturePositions(const Frame& frame, TrackResult& result) const;
 
   Map& map_;

@@ -1,4 +1,5 @@
 #include "map/map.h"
+#include "map/map_participant.h"
 
 #include <algorithm>
 #include <stdexcept>
@@ -354,20 +355,21 @@ Map::Reclamation Map::reclamation() const {
 }
 
 MapParticipant::MapParticipant(Map& map, std::string name) : map_(map), name_(std::move(name)) {
-  std::lock_guard lock(map_.updateMutex());
+  MutexLock lock(map_.updateMutex());
   safe_through_ = map_.erasures_;
   map_.participants_.push_back(this);
 }
 
 MapParticipant::~MapParticipant() {
-  std::lock_guard lock(map_.updateMutex());
+  MutexLock lock(map_.updateMutex());
   std::erase(map_.participants_, this);
   map_.reclaim();
 }
 
-void MapParticipant::quiescent() {
-  safe_through_ = map_.erasures_;
-  map_.reclaim();
+void MapParticipant::quiescent(Map& map) {
+  if (&map != &map_) throw std::logic_error("MapParticipant::quiescent: not this participant's map");
+  safe_through_ = map.erasures_;
+  map.reclaim();
 }
 
 MapChanges& Map::record() {

@@ -3,14 +3,15 @@
 // change is recorded (MapChanges) for the slices that keep client and edge in step.
 //
 // Thread safety: callers hold updateMutex() around any sequence of calls that reads or changes the
-// map from more than one thread (tracking holds it for a frame; mapping for each change it
-// applies). An erased element stays allocated until every thread that keeps pointers beyond the
-// mutex (a MapParticipant) has passed a quiescent point; then an erased point is freed and an
-// erased keyframe drops its features, leaving its pose in the spanning tree.
+// map (tracking holds it for a frame; mapping for each change it applies). Every such method is
+// REQUIRES(update_mutex_), so the clang build (-Wthread-safety) rejects a call without it; a caller
+// names it as REQUIRES(map.updateMutex()). An erased element stays allocated until every thread
+// that keeps pointers beyond the mutex (a MapParticipant) has passed a quiescent point; then an
+// erased point is freed and an erased keyframe drops its features, leaving its pose in the spanning
+// tree.
 #include <cstdint>
 #include <deque>
 #include <memory>
-#include <mutex>
 #include <span>
 #include <unordered_map>
 #include <utility>
@@ -18,10 +19,13 @@
 
 #include "map/keyframe.h"
 #include "map/map_changes.h"
-#include "map/map_participant.h"
 #include "map/map_point.h"
+#include "util/mutex.h"
+#include "util/thread_annotations.h"
 
 namespace edgeslam {
+
+class MapParticipant;
 
 class Map {
  public:
@@ -29,34 +33,35 @@ class Map {
   Map(const Map&) = delete;
   Map& operator=(const Map&) = delete;
 
-  std::mutex& updateMutex() const { return update_mutex_; }
+  Mutex& updateMutex() const RETURN_CAPABILITY(update_mutex_) { return update_mutex_; }
 
   // Creation. `id` = kInvalidId allocates a fresh one; a given id is used as is (replicas).
   KeyFrame* createKeyFrame(std::size_t frame_index, double timestamp,
                            std::shared_ptr<const FrameFeatures> features, const SE3d& T_cw,
-                           KeyFrameId id = kInvalidId);
+                           KeyFrameId id = kInvalidId) REQUIRES(update_mutex_);
   MapPoint* createMapPoint(const Eigen::Vector3d& position, KeyFrame* reference,
-                           MapPointId id = kInvalidId);
+                           MapPointId id = kInvalidId) REQUIRES(update_mutex_);
 
   // Observations link a point and a keypoint both ways.
-  void addObservation(MapPoint* point, KeyFrame* keyframe, std::size_t index);
+  void addObservation(MapPoint* point, KeyFrame* keyframe, std::size_t index)
+      REQUIRES(update_mutex_);
   // Unlinks; a point left with fewer than two observations is erased.
-  void eraseObservation(MapPoint* point, KeyFrame* keyframe);
+  void eraseObservation(MapPoint* point, KeyFrame* keyframe) REQUIRES(update_mutex_);
   // Unlinks without that cull, erasing the point only when no observation is left: a replica
   // mirroring the other side, which culls for itself.
-  void detachObservation(MapPoint* point, KeyFrame* keyframe);
-  void erasePoint(MapPoint* point);
+  void detachObservation(MapPoint* point, KeyFrame* keyframe) REQUIRES(update_mutex_);
+  void erasePoint(MapPoint* point) REQUIRES(update_mutex_);
   // Moves every observation of `old_point` to `replacement` (point fusion) and erases `old_point`.
-  void replacePoint(MapPoint* old_point, MapPoint* replacement);
-  void setPointPosition(MapPoint* point, const Eigen::Vector3d& position);
+  void replacePoint(MapPoint* old_point, MapPoint* replacement) REQUIRES(update_mutex_);
+  void setPointPosition(MapPoint* point, const Eigen::Vector3d& position) REQUIRES(update_mutex_);
   // Sets the position and recomputes what follows from it (normal, distance range), keeping the
   // descriptor: a replica applying a move.
-  void relocatePoint(MapPoint* point, const Eigen::Vector3d& position);
+  void relocatePoint(MapPoint* point, const Eigen::Vector3d& position) REQUIRES(update_mutex_);
   // Sets what refreshPoint would compute, as received from the other side of the wire.
   void setPointAppearance(MapPoint* point, const Eigen::Vector3d& normal, const cv::Mat& descriptor,
-                          float min_distance, float max_distance);
+                          float min_distance, float max_distance) REQUIRES(update_mutex_);
   // Recomputes normal, distance range and representative descriptor from the observations.
-  void refreshPoint(MapPoint* point);
+  void refreshPoint(MapPoint* point) REQUIRES(update_mutex_);
 
   // Bulk load (a stored session into a map that has no points yet), none of it recorded as a
   // change: room for `count` more points; each point as createMapPoint, addObservation on each
@@ -72,45 +77,55 @@ class Map {
     float min_distance = 0.f;
     float max_distance = 0.f;
   };
-  void reservePoints(std::size_t count) { points_.reserve(points_.size() + count); }
-  MapPoint* loadPoint(const PointLoad& load);
-  void linkAllConnections();
+  void reservePoints(std::size_t count) REQUIRES(update_mutex_) {
+    points_.reserve(points_.size() + count);
+  }
+  MapPoint* loadPoint(const PointLoad& load) REQUIRES(update_mutex_);
+  void linkAllConnections() REQUIRES(update_mutex_);
 
-  void setKeyFramePose(KeyFrame* keyframe, const SE3d& T_cw);
-  void updateConnections(KeyFrame* keyframe);
+  void setKeyFramePose(KeyFrame* keyframe, const SE3d& T_cw) REQUIRES(update_mutex_);
+  void updateConnections(KeyFrame* keyframe) REQUIRES(update_mutex_);
   // Removes a redundant keyframe: unlinks its observations and re-parents its spanning-tree
   // children.
-  void eraseKeyFrame(KeyFrame* keyframe);
-  void addLoopEdge(KeyFrame* a, KeyFrame* b);
+  void eraseKeyFrame(KeyFrame* keyframe) REQUIRES(update_mutex_);
+  void addLoopEdge(KeyFrame* a, KeyFrame* b) REQUIRES(update_mutex_);
   // A replica bounding what it holds: the keyframe keeps its id, pose and spanning-tree links (so
   // poses relative to it still follow corrections) but drops its features, its observations and
   // its covisibility links; points left without any observation are erased. No-op when bad or
   // already evicted.
-  void evictKeyFrame(KeyFrame* keyframe);
+  void evictKeyFrame(KeyFrame* keyframe) REQUIRES(update_mutex_);
   // Gives an evicted keyframe its features back (no points yet: the caller links them).
-  void restoreKeyFrame(KeyFrame* keyframe, std::shared_ptr<const FrameFeatures> features);
+  void restoreKeyFrame(KeyFrame* keyframe, std::shared_ptr<const FrameFeatures> features)
+      REQUIRES(update_mutex_);
   // Empties the map (a failed start); ids keep counting up.
-  void clear();
-  void protectKeyFrame(KeyFrame* keyframe) { keyframe->protected_from_culling_ = true; }
+  void clear() REQUIRES(update_mutex_);
+  void protectKeyFrame(KeyFrame* keyframe) REQUIRES(update_mutex_) {
+    keyframe->protected_from_culling_ = true;
+  }
 
-  std::size_t keyFrameCount() const { return keyframes_.size(); }
+  std::size_t keyFrameCount() const REQUIRES(update_mutex_) { return keyframes_.size(); }
   // Keyframes that are not evicted (with their features and points).
-  std::size_t heldKeyFrameCount() const { return keyframes_.size() - evicted_keyframes_; }
-  std::size_t pointCount() const { return points_.size(); }
-  std::vector<KeyFrame*> keyFrames() const;  // sorted by id
-  std::vector<MapPoint*> mapPoints() const;  // sorted by id
+  std::size_t heldKeyFrameCount() const REQUIRES(update_mutex_) {
+    return keyframes_.size() - evicted_keyframes_;
+  }
+  std::size_t pointCount() const REQUIRES(update_mutex_) { return points_.size(); }
+  std::vector<KeyFrame*> keyFrames() const REQUIRES(update_mutex_);  // sorted by id
+  std::vector<MapPoint*> mapPoints() const REQUIRES(update_mutex_);  // sorted by id
   // Positions of at most `max_count` points spread over the map (every k-th in storage order, no
   // sorting): a cheap look for display while tracking waits on the mutex.
-  std::vector<Eigen::Vector3d> pointPositionSample(std::size_t max_count) const;
-  KeyFrame* keyFrame(KeyFrameId id) const;  // nullptr when absent or erased
-  MapPoint* mapPoint(MapPointId id) const;
-  KeyFrame* originKeyFrame() const { return origin_; }
+  std::vector<Eigen::Vector3d> pointPositionSample(std::size_t max_count) const
+      REQUIRES(update_mutex_);
+  // nullptr when absent or erased.
+  KeyFrame* keyFrame(KeyFrameId id) const REQUIRES(update_mutex_);
+  MapPoint* mapPoint(MapPointId id) const REQUIRES(update_mutex_);
+  KeyFrame* originKeyFrame() const REQUIRES(update_mutex_) { return origin_; }
 
-  const MapChanges& changes() const { return changes_; }
-  MapChanges takeChanges();
+  const MapChanges& changes() const REQUIRES(update_mutex_) { return changes_; }
+  MapChanges takeChanges() REQUIRES(update_mutex_);
   // While off, changes are applied but not recorded (a replica applying what the other side sent).
-  void setChangeRecording(bool on) { recording_ = on; }
+  void setChangeRecording(bool on) REQUIRES(update_mutex_) { recording_ = on; }
 
+  // Needs no lock: the allocator is atomic.
   IdAllocator& ids() { return ids_; }
 
   // Erased elements freed so far, and those still waiting for a participant's quiescent point.
@@ -121,7 +136,7 @@ class Map {
     std::size_t keyframes_waiting = 0;
     std::size_t participants = 0;
   };
-  Reclamation reclamation() const;
+  Reclamation reclamation() const REQUIRES(update_mutex_);
 
  private:
   friend class MapParticipant;
@@ -134,30 +149,32 @@ class Map {
     KeyFrame* keyframe;  // owned by erased_keyframes_
   };
 
-  mutable std::mutex update_mutex_;
+  mutable Mutex update_mutex_;
   IdAllocator ids_;
-  std::unordered_map<KeyFrameId, std::unique_ptr<KeyFrame>> keyframes_;
-  std::unordered_map<MapPointId, std::unique_ptr<MapPoint>> points_;
+  std::unordered_map<KeyFrameId, std::unique_ptr<KeyFrame>> keyframes_ GUARDED_BY(update_mutex_);
+  std::unordered_map<MapPointId, std::unique_ptr<MapPoint>> points_ GUARDED_BY(update_mutex_);
   // Erasures are numbered; participants say through which number they hold nothing erased.
-  std::uint64_t erasures_ = 0;
-  std::deque<RetiredPoint> retired_points_;
-  std::deque<RetiredKeyFrame> keyframes_to_release_;
-  std::vector<std::unique_ptr<KeyFrame>> erased_keyframes_;
-  std::vector<MapParticipant*> participants_;
-  Reclamation reclaimed_;
-  KeyFrame* origin_ = nullptr;
-  std::size_t evicted_keyframes_ = 0;  // live (not erased) keyframes that are evicted
-  MapChanges changes_;
-  MapChanges ignored_changes_;
-  bool recording_ = true;
+  std::uint64_t erasures_ GUARDED_BY(update_mutex_) = 0;
+  std::deque<RetiredPoint> retired_points_ GUARDED_BY(update_mutex_);
+  std::deque<RetiredKeyFrame> keyframes_to_release_ GUARDED_BY(update_mutex_);
+  std::vector<std::unique_ptr<KeyFrame>> erased_keyframes_ GUARDED_BY(update_mutex_);
+  std::vector<MapParticipant*> participants_ GUARDED_BY(update_mutex_);
+  Reclamation reclaimed_ GUARDED_BY(update_mutex_);
+  KeyFrame* origin_ GUARDED_BY(update_mutex_) = nullptr;
+  // Live (not erased) keyframes that are evicted.
+  std::size_t evicted_keyframes_ GUARDED_BY(update_mutex_) = 0;
+  MapChanges changes_ GUARDED_BY(update_mutex_);
+  MapChanges ignored_changes_ GUARDED_BY(update_mutex_);
+  bool recording_ GUARDED_BY(update_mutex_) = true;
 
-  MapChanges& record();
-  void retire(std::unique_ptr<MapPoint> point);
-  void retire(std::unique_ptr<KeyFrame> keyframe);
+  MapChanges& record() REQUIRES(update_mutex_);
+  void retire(std::unique_ptr<MapPoint> point) REQUIRES(update_mutex_);
+  void retire(std::unique_ptr<KeyFrame> keyframe) REQUIRES(update_mutex_);
   // Frees what every participant has passed. Called from a quiescent point only: a map nobody
   // participates in keeps its erased elements until it is destroyed.
-  void reclaim();
-  void unlinkConnections(KeyFrame* keyframe);  // covisibility links, both ways
+  void reclaim() REQUIRES(update_mutex_);
+  // Covisibility links, both ways.
+  void unlinkConnections(KeyFrame* keyframe) REQUIRES(update_mutex_);
 };
 
 }  // namespace edgeslam

@@ -100,6 +100,6 @@ bool canMatchForTriangulationByBow(const KeyFrame& kf1, const KeyFrame& kf2);
 // projected point), otherwise the point gains an observation and is refreshed. All changes go
 // through `map`. Returns the number fused.
 int fuse(Map& map, KeyFrame* keyframe, const std::vector<MapPoint*>& points,
-         const PinholeCamera& camera, float radius = 3.0f);
+         const PinholeCamera& camera, float radius = 3.0f) REQUIRES(map.updateMutex());
 
 }  // namespace edgeslam

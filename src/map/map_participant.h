@@ -11,21 +11,24 @@
 #include <cstdint>
 #include <string>
 
-namespace edgeslam {
+#include "map/map.h"
+#include "util/thread_annotations.h"
 
-class Map;
+namespace edgeslam {
 
 class MapParticipant {
  public:
   // Both take the map's mutex: not while holding it.
-  MapParticipant(Map& map, std::string name);
+  MapParticipant(Map& map, std::string name) EXCLUDES(map.updateMutex());
   ~MapParticipant();
   MapParticipant(const MapParticipant&) = delete;
   MapParticipant& operator=(const MapParticipant&) = delete;
 
   // The caller holds the map's updateMutex() and has dropped every pointer it keeps to an erased
   // element (it may go on keeping pointers to live ones). Frees what no participant can reach.
-  void quiescent();
+  // `map` is the map this participates in (std::logic_error otherwise): named by the caller so
+  // that the compiler sees the caller's lock is that map's.
+  void quiescent(Map& map) REQUIRES(map.updateMutex());
 
   const std::string& name() const { return name_; }
 

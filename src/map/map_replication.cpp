@@ -212,26 +212,27 @@ std::optional<UploadedPointConflict> insertUploadedPoint(Map& map, const MapPoin
   MapPointRecord applied = record;
   MapPoint* occupant = nullptr;
   bool dropped = false;
-  std::erase_if(applied.observations, [&](const PointObservationRecord& obs) {
-    if (obs.keyframe == uploaded_keyframe) return false;
-    const KeyFrame* kf = map.keyFrame(obs.keyframe);
-    // A later keyframe of the sender (not here yet) links the point when it arrives.
-    if (kf == nullptr && idOrigin(obs.keyframe) == idOrigin(uploaded_keyframe) &&
-        obs.keyframe > uploaded_keyframe) {
-      return false;
-    }
-    if (kf == nullptr || obs.keypoint_index >= kf->size()) {
-      dropped = true;
-      return true;
-    }
-    MapPoint* there = kf->point(obs.keypoint_index);
-    if (there != nullptr && !there->isBad() && there->id() != record.id) {
-      if (occupant == nullptr) occupant = there;
-      dropped = true;
-      return true;
-    }
-    return false;
-  });
+  std::erase_if(applied.observations,
+                [&](const PointObservationRecord& obs) REQUIRES(map.updateMutex()) {
+                  if (obs.keyframe == uploaded_keyframe) return false;
+                  const KeyFrame* kf = map.keyFrame(obs.keyframe);
+                  // A later keyframe of the sender (not here yet) links the point when it arrives.
+                  if (kf == nullptr && idOrigin(obs.keyframe) == idOrigin(uploaded_keyframe) &&
+                      obs.keyframe > uploaded_keyframe) {
+                    return false;
+                  }
+                  if (kf == nullptr || obs.keypoint_index >= kf->size()) {
+                    dropped = true;
+                    return true;
+                  }
+                  MapPoint* there = kf->point(obs.keypoint_index);
+                  if (there != nullptr && !there->isBad() && there->id() != record.id) {
+                    if (occupant == nullptr) occupant = there;
+                    dropped = true;
+                    return true;
+                  }
+                  return false;
+                });
   MapPoint* point = upsertPointRecord(map, applied, uploaded_keyframe);
   if (point == nullptr) return std::nullopt;
   map.refreshPoint(point);
@@ -243,7 +244,7 @@ namespace {
 
 // Records the point as updated, so that the next slice carries all of it (observations too): the
 // client's copy differs in more than the changes recorded here show.
-void sendAgain(Map& map, MapPoint* point) {
+void sendAgain(Map& map, MapPoint* point) REQUIRES(map.updateMutex()) {
   map.setPointAppearance(point, point->normal(), point->descriptor(), point->baseMinDistance(),
                          point->baseMaxDistance());
 }

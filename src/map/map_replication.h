@@ -27,7 +27,8 @@ KeyFramePoseRecord keyFramePoseRecord(const KeyFrame& keyframe);
 // Creates the keyframe with the record's id (or returns the existing one; an evicted one gets the
 // record's features and pose back) and links the keypoints whose point ids the map already has.
 // Points named but unknown are left for the caller.
-KeyFrame* insertKeyFrameRecord(Map& map, const KeyFrameRecord& record, const PinholeCamera& camera);
+KeyFrame* insertKeyFrameRecord(Map& map, const KeyFrameRecord& record, const PinholeCamera& camera)
+    REQUIRES(map.updateMutex());
 
 // Creates or updates a point so that its position, appearance and its observations among the
 // keyframes this map has match the record. Observations in keyframes newer than
@@ -36,7 +37,7 @@ KeyFrame* insertKeyFrameRecord(Map& map, const KeyFrameRecord& record, const Pin
 // a keyframe newer than `newest_known_to_sender` (the sender will settle that clash). Returns
 // nullptr when none of the observing keyframes is here (nothing to attach it to).
 MapPoint* upsertPointRecord(Map& map, const MapPointRecord& record,
-                            KeyFrameId newest_known_to_sender);
+                            KeyFrameId newest_known_to_sender) REQUIRES(map.updateMutex());
 
 // A new point of a client's keyframe upload, on the edge. The point may be seen in older keyframes
 // of the client too (monocular clients triangulate with their neighbours), which the edge may have
@@ -51,11 +52,13 @@ struct UploadedPointConflict {
   MapPoint* occupant = nullptr;  // the edge's point on one of its keypoints, if any
 };
 std::optional<UploadedPointConflict> insertUploadedPoint(Map& map, const MapPointRecord& record,
-                                                         KeyFrameId uploaded_keyframe);
+                                                         KeyFrameId uploaded_keyframe)
+    REQUIRES(map.updateMutex());
 // With change recording on: a point whose keypoint held another point merges into that one
 // (Map::replacePoint, as fusion would); one that only lost observations is erased when that left
 // it as weak as Map::eraseObservation would (the client erases it then) or sent again.
-void resolveUploadedPointConflicts(Map& map, const std::vector<UploadedPointConflict>& conflicts);
+void resolveUploadedPointConflicts(Map& map, const std::vector<UploadedPointConflict>& conflicts)
+    REQUIRES(map.updateMutex());
 
 // Uploads of RGB-D keyframes. The sender flags a new point whose position is the back-projection
 // of its first observation in `keyframe` (within 0.1 mm), so that the wire can leave it out...

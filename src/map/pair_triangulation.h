@@ -62,6 +62,6 @@ inline std::optional<Eigen::Vector3d> triangulateMatchedPair(
 std::vector<std::pair<std::size_t, MapPoint*>> createPointsFromPairs(
     Map& map, KeyFrame* kf1, KeyFrame* kf2,
     const std::vector<std::pair<std::size_t, std::size_t>>& pairs, const PinholeCamera& camera,
-    double min_parallax_deg = kDefaultMinTriangulationParallaxDeg);
+    double min_parallax_deg = kDefaultMinTriangulationParallaxDeg) REQUIRES(map.updateMutex());
 
 }  // namespace edgeslam

@@ -161,9 +161,9 @@ void LocalMapper::run() {
 }
 
 void LocalMapper::releaseErased() {
-  std::lock_guard lock(map_.updateMutex());
+  MutexLock lock(map_.updateMutex());
   recent_points_.remove_if([](const MapPoint* p) { return p->isBad(); });
-  map_participant_.quiescent();
+  map_participant_.quiescent(map_);
 }
 
 void LocalMapper::processKeyFrame(KeyFrame* keyframe) {
@@ -202,12 +202,12 @@ void LocalMapper::mapKeyFrame(KeyFrame* keyframe) {
   if (reset_requested_.exchange(false)) recent_points_.clear();
   {
     // Once erased, a keyframe's features may be freed at any quiescent point.
-    std::lock_guard lock(map_.updateMutex());
+    MutexLock lock(map_.updateMutex());
     if (keyframe->isBad()) return;
   }
   describe(keyframe);
   {
-    std::lock_guard lock(map_.updateMutex());
+    MutexLock lock(map_.updateMutex());
     if (keyframe->isBad()) return;
     linkKeyFrame(keyframe);
     if (options_.observe_recent_points) observeRecentPoints(keyframe);
@@ -218,7 +218,7 @@ void LocalMapper::mapKeyFrame(KeyFrame* keyframe) {
   if (!hasPending()) {
     bool enough_keyframes = false;
     {
-      std::lock_guard lock(map_.updateMutex());
+      MutexLock lock(map_.updateMutex());
       enough_keyframes = map_.keyFrameCount() > 2 && !keyframe->isBad();
     }
     if (enough_keyframes && options_.run_local_ba) {
@@ -282,7 +282,7 @@ void LocalMapper::createNewPoints(KeyFrame* keyframe) {
   const bool mono = options_.monocular;
   std::vector<KeyFrame*> neighbours;
   {
-    std::lock_guard lock(map_.updateMutex());
+    MutexLock lock(map_.updateMutex());
     if (keyframe->isBad()) return;
     neighbours = keyframe->bestCovisibles(mono ? options_.triangulation_neighbours_mono
                                                : options_.triangulation_neighbours_depth);
@@ -297,7 +297,7 @@ void LocalMapper::createNewPoints(KeyFrame* keyframe) {
 
   for (KeyFrame* neighbour : neighbours) {
     if (hasPending() && created > 0) break;
-    std::lock_guard lock(map_.updateMutex());
+    MutexLock lock(map_.updateMutex());
     if (neighbour->isBad() || keyframe->isBad()) continue;
     const Eigen::Vector3d c1 = keyframe->cameraCenter();
     const Eigen::Vector3d c2 = neighbour->cameraCenter();
@@ -337,7 +337,7 @@ void LocalMapper::createNewPoints(KeyFrame* keyframe) {
 }
 
 void LocalMapper::fuseWithNeighbours(KeyFrame* keyframe) {
-  std::lock_guard lock(map_.updateMutex());
+  MutexLock lock(map_.updateMutex());
   if (keyframe->isBad()) return;
   const std::size_t n =
       options_.monocular ? options_.fusion_neighbours_mono : options_.fusion_neighbours_depth;
@@ -393,7 +393,7 @@ KeyFrameRedundancy LocalMapper::redundancy(const KeyFrame& kf) const {
 }
 
 bool LocalMapper::cullRevisit(KeyFrame* keyframe) {
-  std::lock_guard lock(map_.updateMutex());
+  MutexLock lock(map_.updateMutex());
   if (keyframe->isBad() || keyframe == map_.originKeyFrame() || keyframe->isProtected()) {
     return false;
   }
@@ -428,7 +428,7 @@ bool LocalMapper::cullRevisit(KeyFrame* keyframe) {
 void LocalMapper::cullKeyFrames(KeyFrame* keyframe) {
   // A keyframe is redundant when 90 % of its points are seen, at the same or a finer scale, by at
   // least three other keyframes.
-  std::lock_guard lock(map_.updateMutex());
+  MutexLock lock(map_.updateMutex());
   if (keyframe->isBad()) return;
   std::size_t culled = 0;
   double best = 0.0;

@@ -18,6 +18,7 @@
 #include "geometry/camera.h"
 #include "map/keyframe_sink.h"
 #include "map/map.h"
+#include "map/map_participant.h"
 #include "map/pair_triangulation.h"
 #include "optimize/map_optimization.h"
 #include "place/vocabulary.h"
@@ -133,9 +134,9 @@ class LocalMapper : public KeyFrameSink {
   void run();
   void processKeyFrame(KeyFrame* keyframe);
   void mapKeyFrame(KeyFrame* keyframe);
-  void linkKeyFrame(KeyFrame* keyframe);
-  void observeRecentPoints(KeyFrame* keyframe);
-  void cullRecentPoints(KeyFrame* keyframe);
+  void linkKeyFrame(KeyFrame* keyframe) REQUIRES(map_.updateMutex());
+  void observeRecentPoints(KeyFrame* keyframe) REQUIRES(map_.updateMutex());
+  void cullRecentPoints(KeyFrame* keyframe) REQUIRES(map_.updateMutex());
   bool searchesByBow() const;
   void createNewPoints(KeyFrame* keyframe);
   void fuseWithNeighbours(KeyFrame* keyframe);

@@ -100,7 +100,7 @@ void LoopCloser::processAll() {
 
 void LoopCloser::fileKeyFrame(KeyFrame* keyframe) {
   detector_.describe(*keyframe);
-  std::lock_guard lock(map_.updateMutex());
+  MutexLock lock(map_.updateMutex());
   if (!keyframe->isBad()) detector_.detect(keyframe, map_, /*search=*/false, /*store=*/true);
 }
 
@@ -145,13 +145,14 @@ void LoopCloser::run() {
 }
 
 void LoopCloser::releaseErased() {
-  std::lock_guard lock(map_.updateMutex());
+  MutexLock lock(map_.updateMutex());
   // Erased keyframes leave the place database a few dozen at a time.
   constexpr std::size_t kForgetEvery = 32;
   if (detector_.describedCount() > map_.keyFrameCount() + kForgetEvery) {
-    detector_.forgetIf([this](KeyFrameId id) { return map_.keyFrame(id) == nullptr; });
+    detector_.forgetIf([this](KeyFrameId id)
+                           REQUIRES(map_.updateMutex()) { return map_.keyFrame(id) == nullptr; });
   }
-  map_participant_.quiescent();
+  map_participant_.quiescent(map_);
 }
 
 void LoopCloser::processKeyFrame(KeyFrame* keyframe) {
@@ -161,7 +162,7 @@ void LoopCloser::processKeyFrame(KeyFrame* keyframe) {
   }
   try {
     {
-      std::unique_lock lock(map_.updateMutex());
+      MutexLock lock(map_.updateMutex());
       if (keyframe->isBad()) return;
     }
     detector_.describe(*keyframe);  // the features never change: no lock needed
@@ -169,7 +170,7 @@ void LoopCloser::processKeyFrame(KeyFrame* keyframe) {
     LoopVerification verification;
     bool verified_any = false;
     {
-      std::unique_lock lock(map_.updateMutex());
+      MutexLock lock(map_.updateMutex());
       if (keyframe->isBad()) return;
       const bool search = map_.keyFrameCount() >= options_.min_map_keyframes &&
                           keyframes_since_loop_ > options_.min_keyframes_since_loop;

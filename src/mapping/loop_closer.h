@@ -16,6 +16,7 @@
 
 #include "geometry/camera.h"
 #include "map/map.h"
+#include "map/map_participant.h"
 #include "map/sensor.h"
 #include "mapping/local_mapper.h"
 #include "mapping/loop_correction.h"

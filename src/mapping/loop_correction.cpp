@@ -39,7 +39,7 @@ LoopCorrectionResult correctLoop(Map& map, const VerifiedLoop& loop, const Pinho
   GraphSnapshot snapshot;
   SE3d current_before;
   {
-    std::lock_guard lock(map.updateMutex());
+    MutexLock lock(map.updateMutex());
     if (current->isBad() || loop_kf->isBad()) return result;
     current_before = current->pose();
     map.updateConnections(current);
@@ -168,7 +168,7 @@ LoopCorrectionResult correctLoop(Map& map, const VerifiedLoop& loop, const Pinho
   const PoseGraphResult solved = optimizePoseGraph(snapshot.graph, graph_options);
   result.pose_graph_ms = timer.elapsedMs();
 
-  std::lock_guard lock(map.updateMutex());
+  MutexLock lock(map.updateMutex());
   MapCorrection correction;
   for (std::size_t v = 0; v < snapshot.vertex_keyframes.size(); ++v) {
     KeyFrame* kf = snapshot.vertex_keyframes[v];

@@ -35,6 +35,6 @@ struct LoopCorrectionResult {
 };
 
 LoopCorrectionResult correctLoop(Map& map, const VerifiedLoop& loop, const PinholeCamera& camera,
-                                 const LoopCorrectionOptions& options);
+                                 const LoopCorrectionOptions& options) EXCLUDES(map.updateMutex());
 
 }  // namespace edgeslam

@@ -60,7 +60,8 @@ class LoopDetector {
   // The caller holds the map's update mutex. The keyframe must have been described. Runs the
   // candidate search and the consistency update, then (unless `store` is false) files the keyframe
   // in the database.
-  LoopDetection detect(KeyFrame* keyframe, const Map& map, bool search = true, bool store = true);
+  LoopDetection detect(KeyFrame* keyframe, const Map& map, bool search = true, bool store = true)
+      REQUIRES(map.updateMutex());
 
   // Forgets the consistency history (after a loop has been closed or the map reset).
   void resetConsistency() { consistency_.reset(); }
@@ -75,7 +76,8 @@ class LoopDetector {
 
  private:
   std::vector<KeyFrame*> groupCandidates(KeyFrame* keyframe, const Map& map,
-                                         const std::vector<PlaceQueryResult>& hits) const;
+                                         const std::vector<PlaceQueryResult>& hits) const
+      REQUIRES(map.updateMutex());
 
   std::shared_ptr<const Vocabulary> vocabulary_;
   LoopDetectorOptions options_;

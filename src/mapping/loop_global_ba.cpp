@@ -18,7 +18,7 @@ LoopGlobalBundleAdjustmentResult runLoopGlobalBundleAdjustment(
   std::vector<MapPoint*> points;
   std::vector<std::pair<KeyFrame*, MapPoint*>> owners;  // per observation
   {
-    std::lock_guard lock(map.updateMutex());
+    MutexLock lock(map.updateMutex());
     keyframes = map.keyFrames();
     if (keyframes.size() < 2) return result;
     std::unordered_map<const KeyFrame*, std::size_t> keyframe_index;
@@ -75,7 +75,7 @@ LoopGlobalBundleAdjustmentResult runLoopGlobalBundleAdjustment(
       if (call) call();
     }
   } after_apply{hooks.after_apply};  // declared before the lock: runs once it is released
-  std::lock_guard lock(map.updateMutex());
+  MutexLock lock(map.updateMutex());
   for (const std::size_t o : solved.outliers) {
     auto [kf, p] = owners[o];
     if (!kf->isBad() && !p->isBad()) {

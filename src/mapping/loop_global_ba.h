@@ -35,6 +35,6 @@ struct GlobalBundleAdjustmentHooks {
 
 LoopGlobalBundleAdjustmentResult runLoopGlobalBundleAdjustment(
     Map& map, const PinholeCamera& camera, const std::atomic<bool>* cancel, int iterations,
-    const GlobalBundleAdjustmentHooks& hooks = {});
+    const GlobalBundleAdjustmentHooks& hooks = {}) EXCLUDES(map.updateMutex());
 
 }  // namespace edgeslam

@@ -34,6 +34,7 @@ struct MapCorrectionStats {
 // The world-to-world similarity a keyframe's correction implies: after^-1 * before.
 Sim3d worldCorrection(const KeyFrameCorrection& correction);
 
-MapCorrectionStats applyMapCorrection(Map& map, const MapCorrection& correction);
+MapCorrectionStats applyMapCorrection(Map& map, const MapCorrection& correction)
+    REQUIRES(map.updateMutex());
 
 }  // namespace edgeslam

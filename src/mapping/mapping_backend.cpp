@@ -201,7 +201,7 @@ void MappingBackend::setNmsThreshold(float nm) {
 void MappingBackend::onSegmented(KeyFrameSegmentationResult result) {
   std::size_t erased = 0;
   {
-    std::lock_guard lock(map_.updateMutex());
+    MutexLock lock(map_.updateMutex());
     if (KeyFrame* keyframe = map_.keyFrame(result.keyframe)) {
       erased = eraseMovablePoints(map_, *keyframe, result.labels, movable_point_erode_px_);
     }

@@ -13,6 +13,6 @@ namespace edgeslam {
 // shrunk by `erode_px`, so that background points along an object's outline survive. The caller
 // holds the map's update mutex. Returns the number of points erased.
 std::size_t eraseMovablePoints(Map& map, KeyFrame& keyframe, const cv::Mat1b& labels,
-                               int erode_px = 2);
+                               int erode_px = 2) REQUIRES(map.updateMutex());
 
 }  // namespace edgeslam

@@ -68,7 +68,7 @@ const KeyFrameTriangulationStats& EdgeSlam::clientTriangulation() const {
 ClientMapSize EdgeSlam::clientMapSize() const {
   std::size_t keyframes = 0, points = 0;
   {
-    std::lock_guard lock(map_.updateMutex());
+    MutexLock lock(map_.updateMutex());
     keyframes = map_.heldKeyFrameCount();
     points = map_.pointCount();
   }
@@ -124,11 +124,10 @@ void EdgeSlam::afterFrame() {
   {
     // Tracking adds keyframes and points between slices: the client map's peak is seen here.
     // Not worth waiting for a slice being applied (it notes the size itself when done).
-    std::unique_lock lock(map_.updateMutex(), std::try_to_lock);
-    if (lock.owns_lock()) {
+    if (map_.updateMutex().try_lock()) {
       const std::size_t keyframes = map_.heldKeyFrameCount();
       const std::size_t points = map_.pointCount();
-      lock.unlock();
+      map_.updateMutex().unlock();
       noteClientMapSize(keyframes, points);
     }
   }
@@ -204,7 +203,7 @@ void EdgeSlam::onFullResync(const std::vector<KeyFrameId>& edge_lacks) {
   std::vector<KeyFrameId> resend;
   std::uint64_t lost_evicted = 0;
   {
-    std::lock_guard lock(map_.updateMutex());
+    MutexLock lock(map_.updateMutex());
     for (const KeyFrameId id : edge_lacks) {
       const KeyFrame* keyframe = map_.keyFrame(id);
       if (keyframe == nullptr || keyframe->isBad() || on_the_way.contains(id)) continue;
@@ -240,7 +239,7 @@ void EdgeSlam::offerMask(const MaskRecord& mask) {
   if (!semantic_filter_) return;
   std::size_t frame_index = 0;
   {
-    std::lock_guard lock(map_.updateMutex());
+    MutexLock lock(map_.updateMutex());
     const KeyFrame* keyframe = map_.keyFrame(mask.keyframe);
     if (keyframe == nullptr) return;  // culled meanwhile: its mask is of no use any more
     frame_index = keyframe->frameIndex();

@@ -54,7 +54,12 @@ void LocalSlam::finish() {
 
 void LocalSlam::refineIntrinsicsOfTheMap() {
   // The map is complete and the mapper idle: nothing else changes it while this runs.
-  spdlog::info("self-calibration over {} keyframes...", map_.keyFrameCount());
+  std::size_t keyframes = 0;
+  {
+    MutexLock lock(map_.updateMutex());
+    keyframes = map_.keyFrameCount();
+  }
+  spdlog::info("self-calibration over {} keyframes...", keyframes);
   intrinsics_refinement_ = refineMapIntrinsics(map_, camera_, options_.intrinsics_refinement);
   spdlog::info("intrinsics {}", describe(*intrinsics_refinement_));
 }

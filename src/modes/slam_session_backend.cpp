@@ -253,7 +253,7 @@ MapSample SlamSessionBackend::mapSample(std::size_t max_points) const {
   MapSample sample;
   if (!mapping_) return sample;
   const Map& map = mapping_->map();
-  std::lock_guard lock(map.updateMutex());
+  MutexLock lock(map.updateMutex());
   for (const KeyFrame* kf : map.keyFrames()) {
     if (!kf->isBad()) sample.keyframe_poses.push_back(kf->poseInverse());
   }

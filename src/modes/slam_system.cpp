@@ -54,7 +54,7 @@ void TrackingSlam::startTracking(KeyFrameSink* sink, std::function<void()> wait_
 void TrackingSlam::noteKeyFrameDepth(KeyFrameId id) {
   std::vector<double> depths;
   {
-    std::lock_guard lock(map_.updateMutex());
+    MutexLock lock(map_.updateMutex());
     const KeyFrame* keyframe = map_.keyFrame(id);
     if (keyframe == nullptr) return;
     const SE3d& T_cw = keyframe->pose();
@@ -134,7 +134,7 @@ Trajectory TrackingSlam::trajectoryAtFrameTime() const {
 }
 
 Trajectory TrackingSlam::trajectoryFinal() const {
-  std::lock_guard lock(map_.updateMutex());
+  MutexLock lock(map_.updateMutex());
   Trajectory out;
   for (const auto& r : tracker_->records()) {
     if (!r.tracked || r.reference == nullptr) continue;
@@ -144,14 +144,14 @@ Trajectory TrackingSlam::trajectoryFinal() const {
 }
 
 Trajectory TrackingSlam::keyframeTrajectory() const {
-  std::lock_guard lock(map_.updateMutex());
+  MutexLock lock(map_.updateMutex());
   Trajectory out;
   for (KeyFrame* kf : map_.keyFrames()) out.push_back({kf->timestamp(), kf->poseInverse()});
   return out;
 }
 
 MapSample TrackingSlam::mapSample(std::size_t max_points) const {
-  std::lock_guard lock(map_.updateMutex());
+  MutexLock lock(map_.updateMutex());
   MapSample sample;
   const std::vector<KeyFrame*> keyframes = map_.keyFrames();
   sample.keyframe_poses.reserve(keyframes.size());
@@ -164,12 +164,12 @@ MapSample TrackingSlam::mapSample(std::size_t max_points) const {
 }
 
 std::size_t TrackingSlam::keyFrameCount() const {
-  std::lock_guard lock(map_.updateMutex());
+  MutexLock lock(map_.updateMutex());
   return map_.keyFrameCount();
 }
 
 std::size_t TrackingSlam::mapPointCount() const {
-  std::lock_guard lock(map_.updateMutex());
+  MutexLock lock(map_.updateMutex());
   return map_.pointCount();
 }
 

@@ -67,10 +67,9 @@ ProblemBuild buildProblem(const std::vector<KeyFrame*>& free_keyframes, KeyFrame
   return build;
 }
 
-// The solved poses of the free keyframes and the solved points into the map (its update mutex
-// held by the caller).
+// The solved poses of the free keyframes and the solved points into the map.
 void writeBack(Map& map, const ProblemBuild& build, const std::vector<SE3d>& T_cw,
-               const std::vector<Eigen::Vector3d>& points) {
+               const std::vector<Eigen::Vector3d>& points) REQUIRES(map.updateMutex()) {
   for (std::size_t k = 0; k < build.keyframes.size(); ++k) {
     if (build.problem.keyframes[k].fixed || build.keyframes[k]->isBad()) continue;
     map.setKeyFramePose(build.keyframes[k], T_cw[k]);
@@ -100,7 +99,7 @@ LocalBundleAdjustmentStats solveAndApply(Map& map, ProblemBuild build,
   stats.rms_after = result.rms_after;
   if (result.cancelled && result.iterations == 0) return stats;
 
-  std::lock_guard lock(map.updateMutex());
+  MutexLock lock(map.updateMutex());
   for (std::size_t o : result.outliers) {
     auto [kf, p] = build.observation_owners[o];
     if (!kf->isBad() && !p->isBad()) {
@@ -143,7 +142,7 @@ LocalBundleAdjustmentStats localBundleAdjustment(Map& map, KeyFrame* keyframe,
                                                  BundleAdjustmentOptions options) {
   ProblemBuild build;
   {
-    std::lock_guard lock(map.updateMutex());
+    MutexLock lock(map.updateMutex());
     if (keyframe->isBad()) return {};
     std::vector<KeyFrame*> window = keyframe->bestCovisibles(static_cast<std::size_t>(-1));
     window.insert(window.begin(), keyframe);
@@ -157,7 +156,7 @@ LocalBundleAdjustmentStats globalBundleAdjustment(Map& map, const PinholeCamera&
                                                   const std::atomic<bool>* cancel, int iterations) {
   ProblemBuild build;
   {
-    std::lock_guard lock(map.updateMutex());
+    MutexLock lock(map.updateMutex());
     build = buildProblem(map.keyFrames(), map.originKeyFrame(), camera);
   }
   BundleAdjustmentOptions options = BundleAdjustmentOptions::global();
@@ -170,7 +169,7 @@ MapIntrinsicsRefinement refineMapIntrinsics(Map& map, const PinholeCamera& camer
                                             const IntrinsicsRefinementOptions& options) {
   ProblemBuild build;
   {
-    std::lock_guard lock(map.updateMutex());
+    MutexLock lock(map.updateMutex());
     build = buildProblem(map.keyFrames(), map.originKeyFrame(), camera);
   }
   MapIntrinsicsRefinement out;
@@ -185,7 +184,7 @@ MapIntrinsicsRefinement refineMapIntrinsics(Map& map, const PinholeCamera& camer
   out.result = refineIntrinsics(build.problem, camera, options);
   out.solve_ms = timer.elapsedMs();
   if (!out.result.adopted) return out;
-  std::lock_guard lock(map.updateMutex());
+  MutexLock lock(map.updateMutex());
   writeBack(map, build, out.result.T_cw, out.result.points);
   return out;
 }

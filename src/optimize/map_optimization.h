@@ -36,12 +36,13 @@ struct LocalBundleAdjustmentStats {
 LocalBundleAdjustmentStats localBundleAdjustment(Map& map, KeyFrame* keyframe,
                                                  const PinholeCamera& camera,
                                                  const std::atomic<bool>* cancel = nullptr,
-                                                 BundleAdjustmentOptions options = {});
+                                                 BundleAdjustmentOptions options = {})
+    EXCLUDES(map.updateMutex());
 
 // Every keyframe and point; the origin keyframe fixed. Same locking as above.
 LocalBundleAdjustmentStats globalBundleAdjustment(Map& map, const PinholeCamera& camera,
                                                   const std::atomic<bool>* cancel = nullptr,
-                                                  int iterations = 20);
+                                                  int iterations = 20) EXCLUDES(map.updateMutex());
 
 struct MapIntrinsicsRefinement {
   IntrinsicsRefinementResult result;
@@ -59,6 +60,7 @@ struct MapIntrinsicsRefinement {
 std::string describe(const MapIntrinsicsRefinement& refinement);
 
 MapIntrinsicsRefinement refineMapIntrinsics(Map& map, const PinholeCamera& camera,
-                                            const IntrinsicsRefinementOptions& options = {});
+                                            const IntrinsicsRefinementOptions& options = {})
+    EXCLUDES(map.updateMutex());
 
 }  // namespace edgeslam

@@ -106,10 +106,11 @@ void ClientMapWindow::shape(const Map& map, KeyFrame* centre, MapSlice& slice) {
   }
   for (const MapPoint* p : entering_points) points.push_back(mapPointRecord(*p));
   slice.points_upserted = std::move(points);
-  std::erase_if(slice.point_positions, [&](const PointPositionRecord& r) {
-    const MapPoint* p = map.mapPoint(r.id);
-    return p == nullptr || !seenByHeld(*p);
-  });
+  std::erase_if(slice.point_positions,
+                [&](const PointPositionRecord& r) REQUIRES(map.updateMutex()) {
+                  const MapPoint* p = map.mapPoint(r.id);
+                  return p == nullptr || !seenByHeld(*p);
+                });
 }
 
 }  // namespace edgeslam

@@ -31,7 +31,7 @@ struct ClientMapWindowOptions {
 // their covisibility neighbourhood breadth first, each keyframe's links strongest first.
 // Deterministic, and a shorter list is a prefix of a longer one.
 std::vector<KeyFrame*> keyFrameNeighbourhood(const Map& map, KeyFrame* centre, std::size_t count,
-                                             std::size_t recent);
+                                             std::size_t recent) REQUIRES(map.updateMutex());
 
 class ClientMapWindow {
  public:
@@ -54,7 +54,7 @@ class ClientMapWindow {
   // points they see that the client lacks, lists the evicted keyframes, and drops point records
   // and moves of points no held keyframe sees. Keyframe poses and erasures are left for every
   // keyframe: the client keeps evicted keyframes' poses. No-op when unbounded.
-  void shape(const Map& map, KeyFrame* centre, MapSlice& slice);
+  void shape(const Map& map, KeyFrame* centre, MapSlice& slice) REQUIRES(map.updateMutex());
 
  private:
   bool seenByHeld(const MapPoint& point) const;

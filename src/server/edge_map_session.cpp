@@ -43,7 +43,7 @@ void EdgeMapSession::adoptPreloadedMap() {
   std::vector<KeyFrame*> loaded;
   KeyFrameId newest = kInvalidId;
   {
-    std::lock_guard lock(map_.updateMutex());
+    MutexLock lock(map_.updateMutex());
     for (KeyFrame* keyframe : map_.keyFrames()) {
       if (keyframe->isBad()) continue;
       loaded.push_back(keyframe);
@@ -89,7 +89,7 @@ void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
   }
   KeyFrame* keyframe = nullptr;
   {
-    std::unique_lock lock(map_.updateMutex());
+    MutexLock lock(map_.updateMutex());
     if (!upload.map_reset && map_.keyFrame(upload.keyframe.id) != nullptr) {
       // Re-sent after a full resync while its first upload was still on its way, or sent to a
       // server that stored it before a restart: the map has it. The client waits for an answer.
@@ -175,7 +175,7 @@ void EdgeMapSession::publishSlice(KeyFrame* mapped, std::uint64_t answers) {
   std::lock_guard publishing(publish_mutex_);
   MapSlice slice;
   {
-    std::lock_guard lock(map_.updateMutex());
+    MutexLock lock(map_.updateMutex());
     const std::size_t loops = backend_->loops();
     std::vector<MaskRecord> masks;
     {
@@ -241,7 +241,7 @@ void EdgeMapSession::publishFullResync() {
   std::lock_guard publishing(publish_mutex_);
   MapSlice slice;
   {
-    std::lock_guard lock(map_.updateMutex());
+    MutexLock lock(map_.updateMutex());
     // What changed since the last slice is in the whole map sent now; the store still needs it.
     MapChanges changes = map_.takeChanges();
     if (observer_ != nullptr) observer_->onMapChanged(changes);

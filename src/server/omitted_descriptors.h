@@ -24,6 +24,7 @@ struct OmittedDescriptorFill {
 // other lost keypoints' rows, far beyond every matching threshold (<= 100). Caller holds the map's
 // update mutex. Throws std::invalid_argument when the flags contradict the record (not one per
 // keypoint, or an omitted keypoint without a point).
-OmittedDescriptorFill fillOmittedDescriptors(const Map& map, KeyFrameRecord& keyframe);
+OmittedDescriptorFill fillOmittedDescriptors(const Map& map, KeyFrameRecord& keyframe)
+    REQUIRES(map.updateMutex());
 
 }  // namespace edgeslam

@@ -7,6 +7,6 @@
 
 namespace edgeslam {
 
-MapSlice buildSlice(const Map& map, const MapChanges& changes);
+MapSlice buildSlice(const Map& map, const MapChanges& changes) REQUIRES(map.updateMutex());
 
 }  // namespace edgeslam

@@ -142,7 +142,7 @@ MapStoreBatch MapStoreWriter::takeBatch() {
     awaiting_place_.clear();
   }
   // What the map holds now decides: an element changed and then erased is erased.
-  std::lock_guard map_lock(map_.updateMutex());
+  MutexLock map_lock(map_.updateMutex());
   for (const KeyFrameId id : keyframes) {
     const KeyFrame* keyframe = map_.keyFrame(id);
     if (keyframe == nullptr || keyframe->isBad()) {

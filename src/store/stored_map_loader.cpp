@@ -24,7 +24,7 @@ namespace {
 // by this side after the sender's newest keyframe" exception cannot arise: every keyframe is the
 // sender's.)
 void createPointRecord(Map& map, const MapPointRecord& record,
-                       std::vector<std::pair<KeyFrame*, std::size_t>>& observers) {
+                       std::vector<std::pair<KeyFrame*, std::size_t>>& observers) REQUIRES(map.updateMutex()) {
   observers.clear();
   for (const PointObservationRecord& obs : record.observations) {
     KeyFrame* kf = map.keyFrame(obs.keyframe);
@@ -49,7 +49,7 @@ void createPointRecord(Map& map, const MapPointRecord& record,
 void fillMap(const StoredSession& session, std::vector<std::shared_ptr<FrameFeatures>>& features,
              Map& map, const Stopwatch& timer) {
   const double features_ms = timer.elapsedMs();
-  std::lock_guard lock(map.updateMutex());
+  MutexLock lock(map.updateMutex());
   // Into an empty map (a server resuming, `map info --load`) points are created without looking
   // for one of the same id first; a map with something in it has its points upserted.
   const bool fresh = map.keyFrameCount() == 0 && map.pointCount() == 0;
@@ -127,7 +127,7 @@ AttachedPlaces attachStoredPlaces(const StoredSession& session, Map& map,
                                   const Vocabulary& vocabulary, std::uint64_t checksum,
                                   int direct_index_depth) {
   AttachedPlaces out;
-  std::lock_guard lock(map.updateMutex());
+  MutexLock lock(map.updateMutex());
   for (const KeyFramePlaceRecord& record : session.places) {
     if (record.vocabulary != checksum || record.direct_index_depth != direct_index_depth) continue;
     KeyFrame* keyframe = map.keyFrame(record.keyframe);
@@ -168,7 +168,7 @@ AttachedPlaces attachStoredPlaces(const StoredSession& session, Map& map,
 std::size_t describeKeyFrames(Map& map, const Vocabulary& vocabulary, int direct_index_depth) {
   std::vector<KeyFrame*> keyframes;
   {
-    std::lock_guard lock(map.updateMutex());
+    MutexLock lock(map.updateMutex());
     for (KeyFrame* keyframe : map.keyFrames()) {
       const auto place = keyframe->place();
       if (keyframe->isBad() || (place != nullptr && place->vocabulary == &vocabulary &&

@@ -19,11 +19,11 @@ namespace edgeslam {
 StoredSession* latestSessionWithKeyFrames(StoredMap& map);
 
 // Into an empty map. Throws StoreError when the records contradict themselves.
-void loadStoredSession(const StoredSession& session, Map& map);
+void loadStoredSession(const StoredSession& session, Map& map) EXCLUDES(map.updateMutex());
 // The same, moving each keyframe's features out of its record instead of copying them (the
 // records keep their ids, poses and point ids; the places are untouched): for a caller done with
 // the features, which spares a 1000-keyframe map ~90 MB of copies.
-void loadStoredSessionTakingFeatures(StoredSession& session, Map& map);
+void loadStoredSessionTakingFeatures(StoredSession& session, Map& map) EXCLUDES(map.updateMutex());
 
 struct AttachedPlaces {
   std::size_t attached = 0;
@@ -35,10 +35,11 @@ struct AttachedPlaces {
 // StoreError when a stored place names words or nodes the vocabulary does not have.
 AttachedPlaces attachStoredPlaces(const StoredSession& session, Map& map,
                                   const Vocabulary& vocabulary, std::uint64_t checksum,
-                                  int direct_index_depth);
+                                  int direct_index_depth) EXCLUDES(map.updateMutex());
 
 // The keyframes' places as local mapping makes them (LocalMapper::describe), for those without
 // one; returns how many were computed.
-std::size_t describeKeyFrames(Map& map, const Vocabulary& vocabulary, int direct_index_depth);
+std::size_t describeKeyFrames(Map& map, const Vocabulary& vocabulary, int direct_index_depth)
+    EXCLUDES(map.updateMutex());
 
 }  // namespace edgeslam

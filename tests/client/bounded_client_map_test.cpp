@@ -7,6 +7,7 @@
 #include "client/slice_applier.h"
 #include "map/map_replication.h"
 #include "mapping/corridor_map.h"
+#include "support/mutex_unlock.h"
 
 namespace edgeslam {
 namespace {
@@ -16,8 +17,18 @@ class BoundedClientMap : public ::testing::Test {
   BoundedClientMap() { edge_.replicateInto(client_); }
 
   // The client's replica of the edge keyframe k / point i.
-  KeyFrame* kf(int k) const { return client_.keyFrame(edge_.id(k)); }
-  MapPoint* point(int i) const { return client_.mapPoint(edge_.points[i]->id()); }
+  KeyFrame* kf(int k) const REQUIRES(client_.updateMutex()) {
+    return client_.keyFrame(edge_.id(k));
+  }
+  MapPoint* point(int i) const REQUIRES(client_.updateMutex()) {
+    return client_.mapPoint(edge_.points[i]->id());
+  }
+
+  // As the client's slice thread: applySlice takes the map's mutex itself.
+  SliceApplyResult apply(const MapSlice& slice) REQUIRES(client_.updateMutex()) {
+    test::MutexUnlock unlock(client_.updateMutex());
+    return applySlice(client_, slice, edge_.camera);
+  }
 
   MapSlice evicting(std::initializer_list<int> keyframes) {
     MapSlice slice;
@@ -32,9 +43,10 @@ class BoundedClientMap : public ::testing::Test {
 };
 
 TEST_F(BoundedClientMap, EvictionKeepsThePoseAndDropsWhatOnlyEvictedKeyFramesSaw) {
+  MutexLock lock(client_.updateMutex());
   ASSERT_EQ(client_.pointCount(), 130u);
   const SE3d pose_before = kf(2)->pose();
-  const SliceApplyResult result = applySlice(client_, evicting({0, 1, 2, 3, 4}), edge_.camera);
+  const SliceApplyResult result = apply(evicting({0, 1, 2, 3, 4}));
   EXPECT_EQ(result.keyframes_evicted.size(), 5u);
   EXPECT_EQ(result.points_evicted, 50u);  // 0..49: keyframe 5 sees 50..89
   EXPECT_EQ(result.keyframes_held, 5u);
@@ -61,17 +73,18 @@ TEST_F(BoundedClientMap, EvictionKeepsThePoseAndDropsWhatOnlyEvictedKeyFramesSaw
   EXPECT_TRUE(kf(5)->connections().count(kf(4)) == 0);
   EXPECT_EQ(kf(5)->weight(kf(6)), 30);
   // Evicting again (a repeated slice) changes nothing.
-  EXPECT_TRUE(applySlice(client_, evicting({2}), edge_.camera).keyframes_evicted.empty());
+  EXPECT_TRUE(apply(evicting({2})).keyframes_evicted.empty());
 }
 
 TEST_F(BoundedClientMap, LaterPoseCorrectionsStillApplyToEvictedKeyFrames) {
-  applySlice(client_, evicting({0, 1, 2}), edge_.camera);
+  MutexLock lock(client_.updateMutex());
+  apply(evicting({0, 1, 2}));
   MapSlice correction;
   correction.sequence = 9;
   const SE3d corrected(Eigen::Quaterniond(Eigen::AngleAxisd(0.1, Eigen::Vector3d::UnitY())),
                        Eigen::Vector3d(0.3, -0.2, 0.05));
   correction.keyframe_poses.push_back({edge_.id(1), corrected, edge_.id(0)});
-  EXPECT_EQ(applySlice(client_, correction, edge_.camera).keyframes_moved, 1u);
+  EXPECT_EQ(apply(correction).keyframes_moved, 1u);
   EXPECT_TRUE((kf(1)->pose().matrix() - corrected.matrix()).isZero(1e-12));
   EXPECT_TRUE((kf(1)->latestPose().matrix() - corrected.matrix()).isZero(1e-12));
   // Erased on the edge later: it keeps following its parent, as erased keyframes do.
@@ -79,7 +92,7 @@ TEST_F(BoundedClientMap, LaterPoseCorrectionsStillApplyToEvictedKeyFrames) {
   erasure.sequence = 10;
   erasure.keyframes_erased = {edge_.id(1)};
   KeyFrame* erased = kf(1);
-  applySlice(client_, erasure, edge_.camera);
+  apply(erasure);
   EXPECT_TRUE(erased->isBad());
   EXPECT_EQ(client_.heldKeyFrameCount(), 7u);
   EXPECT_EQ(client_.keyFrameCount(), 9u);
@@ -87,7 +100,8 @@ TEST_F(BoundedClientMap, LaterPoseCorrectionsStillApplyToEvictedKeyFrames) {
 }
 
 TEST_F(BoundedClientMap, RecordsForWhatTheClientDoesNotHoldAreIgnored) {
-  applySlice(client_, evicting({0, 1, 2, 3, 4}), edge_.camera);
+  MutexLock lock(client_.updateMutex());
+  apply(evicting({0, 1, 2, 3, 4}));
   const std::size_t points = client_.pointCount();
   MapSlice slice;
   slice.sequence = 7;
@@ -104,7 +118,7 @@ TEST_F(BoundedClientMap, RecordsForWhatTheClientDoesNotHoldAreIgnored) {
   MapPointRecord moved = mapPointRecord(*edge_.points[55]);
   moved.position = {1, 2, 3};
   slice.points_upserted.push_back(moved);
-  const SliceApplyResult result = applySlice(client_, slice, edge_.camera);
+  const SliceApplyResult result = apply(slice);
   EXPECT_EQ(result.points_upserted, 1u);
   EXPECT_EQ(result.points_moved, 0u);
   EXPECT_EQ(result.points_erased, 0u);
@@ -119,14 +133,15 @@ TEST_F(BoundedClientMap, RecordsForWhatTheClientDoesNotHoldAreIgnored) {
 }
 
 TEST_F(BoundedClientMap, KeyFrameBackInTheWindowIsWholeAgain) {
-  applySlice(client_, evicting({0, 1, 2, 3, 4}), edge_.camera);
+  MutexLock lock(client_.updateMutex());
+  apply(evicting({0, 1, 2, 3, 4}));
   // What the edge sends on a revisit: keyframe 4 and the points of it the client lacks.
   MapSlice slice;
   slice.sequence = 5;
   slice.newest_keyframe = edge_.id(9);
   slice.keyframes.push_back(keyFrameRecord(*edge_.keyframes[4]));
   for (int i = 40; i < 50; ++i) slice.points_upserted.push_back(mapPointRecord(*edge_.points[i]));
-  const SliceApplyResult result = applySlice(client_, slice, edge_.camera);
+  const SliceApplyResult result = apply(slice);
   ASSERT_EQ(result.keyframes_entered.size(), 1u);
   EXPECT_EQ(result.keyframes_entered[0], edge_.id(4));
   EXPECT_FALSE(kf(4)->isEvicted());

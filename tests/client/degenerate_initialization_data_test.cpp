@@ -56,6 +56,7 @@ TEST_F(DegenerateInput, StillCameraBuildsNoMapAndSaysLowParallax) {
   EXPECT_FALSE(d.initialized_at_frame.has_value());
   EXPECT_EQ(d.frames_without_map, 20u);
   EXPECT_EQ(d.refused(InitRefusal::kLowParallax), 19u) << d.last_refusal;
+  MutexLock lock(map_.updateMutex());
   EXPECT_EQ(map_.keyFrameCount(), 0u);
 }
 

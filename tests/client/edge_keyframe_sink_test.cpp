@@ -26,7 +26,12 @@ TEST(EdgeKeyFrameSink, StarvingTrackingMayHaveAFewMoreUploadsInFlight) {
   EdgeKeyFrameSink sink(map, uplink, options);
   const auto features = test::emptyFeatures(test::syntheticCamera());
   const auto upload = [&](std::size_t frame) {
-    sink.insertKeyFrame(map.createKeyFrame(frame, 0.0, features, SE3d()));
+    KeyFrame* keyframe = nullptr;
+    {
+      MutexLock lock(map.updateMutex());
+      keyframe = map.createKeyFrame(frame, 0.0, features, SE3d());
+    }
+    sink.insertKeyFrame(keyframe);  // takes the map's mutex itself
   };
   for (std::size_t frame = 0; frame < 3; ++frame) {
     EXPECT_TRUE(sink.acceptsKeyFrames());
@@ -57,7 +62,12 @@ TEST(EdgeKeyFrameSink, MapUpdatesArePausedWhileTheEdgeIsUnreachable) {
   EdgeKeyFrameSink sink(map, uplink, options);
   const auto features = test::emptyFeatures(test::syntheticCamera());
   EXPECT_FALSE(sink.mapUpdatesPaused());
-  sink.insertKeyFrame(map.createKeyFrame(0, 0.0, features, SE3d()));
+  KeyFrame* keyframe = nullptr;
+  {
+    MutexLock lock(map.updateMutex());
+    keyframe = map.createKeyFrame(0, 0.0, features, SE3d());
+  }
+  sink.insertKeyFrame(keyframe);
   EXPECT_FALSE(sink.acceptsKeyFrames());
   uplink.edge_unreachable = true;
   EXPECT_TRUE(sink.mapUpdatesPaused());

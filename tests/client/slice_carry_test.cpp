@@ -27,8 +27,12 @@ TEST(SliceCarry, NewerClientKeyFramesAndTheirPointsFollowTheProcessedKeyFrame) {
   KeyFrame* processed = t.processed;
   KeyFrame* newer = t.newer;
   // The client triangulated a point in the newer keyframe; the edge has not heard of it.
-  MapPoint* own_point = client.createMapPoint({0.3, 0.1, 3.0}, newer);
-  client.addObservation(own_point, newer, 0);
+  MapPoint* own_point = nullptr;
+  {
+    MutexLock lock(client.updateMutex());
+    own_point = client.createMapPoint({0.3, 0.1, 3.0}, newer);
+    client.addObservation(own_point, newer, 0);
+  }
   MapPoint* edge_point = processed->point(1);
   ASSERT_NE(edge_point, nullptr);
 

@@ -6,6 +6,7 @@
 #include "map/map_replication.h"
 #include "map/synthetic_views.h"
 #include "server/slice_builder.h"
+#include "support/mutex_unlock.h"
 
 namespace edgeslam {
 namespace {
@@ -47,7 +48,7 @@ struct EdgeAndClient {
   }
 };
 
-void expectSameMaps(const Map& a, const Map& b) {
+void expectSameMaps(const Map& a, const Map& b) REQUIRES(a.updateMutex(), b.updateMutex()) {
   ASSERT_EQ(a.keyFrameCount(), b.keyFrameCount());
   ASSERT_EQ(a.pointCount(), b.pointCount());
   for (MapPoint* p : a.mapPoints()) {
@@ -67,12 +68,16 @@ void expectSameMaps(const Map& a, const Map& b) {
 
 TEST(SliceRoundTrip, ReplicaFromRecordsMatchesTheOriginal) {
   EdgeAndClient t;
+  MutexLock edge_lock(t.edge.updateMutex());
+  MutexLock client_lock(t.client.updateMutex());
   EXPECT_GT(t.edge.pointCount(), 100u);
   expectSameMaps(t.edge, t.client);
 }
 
 TEST(SliceRoundTrip, SliceCarriesMovesErasuresAndPoseCorrections) {
   EdgeAndClient t;
+  MutexLock edge_lock(t.edge.updateMutex());
+  MutexLock client_lock(t.client.updateMutex());
   std::vector<MapPoint*> points = t.edge.mapPoints();
   t.edge.setPointPosition(points[0], points[0]->position() + Eigen::Vector3d(0.05, 0, 0));
   t.edge.erasePoint(points[1]);
@@ -98,7 +103,11 @@ TEST(SliceRoundTrip, SliceCarriesMovesErasuresAndPoseCorrections) {
   slice.newest_keyframe = moved->id();
   EXPECT_EQ(slice.points_erased.size(), 1u);
   EXPECT_EQ(slice.keyframe_poses.size(), 1u);
-  const SliceApplyResult applied = applySlice(t.client, slice, t.scene.camera());
+  SliceApplyResult applied;
+  {
+    test::MutexUnlock unlock(t.client.updateMutex());  // applySlice takes it
+    applied = applySlice(t.client, slice, t.scene.camera());
+  }
   EXPECT_EQ(applied.points_erased, 1u);
   EXPECT_EQ(applied.keyframes_moved, 1u);
   expectSameMaps(t.edge, t.client);
@@ -108,6 +117,8 @@ TEST(SliceRoundTrip, SliceCarriesMovesErasuresAndPoseCorrections) {
 
 TEST(SliceRoundTrip, ObservationsInKeyFramesTheEdgeHasNotSeenSurvive) {
   EdgeAndClient t;
+  MutexLock edge_lock(t.edge.updateMutex());
+  MutexLock client_lock(t.client.updateMutex());
   MapPoint* p = t.edge.mapPoints().front();
   // The client links the point in a keyframe the edge has not received yet.
   const auto view = t.scene.view(test::poseAt({0.3, 0, 0}), 0, false);
@@ -119,7 +130,10 @@ TEST(SliceRoundTrip, ObservationsInKeyFramesTheEdgeHasNotSeenSurvive) {
   t.edge.setPointPosition(p, p->position() + Eigen::Vector3d(0, 0.01, 0));
   MapSlice slice = buildSlice(t.edge, t.edge.takeChanges());
   slice.newest_keyframe = t.edge_keyframes.back()->id();
-  applySlice(t.client, slice, t.scene.camera());
+  {
+    test::MutexUnlock unlock(t.client.updateMutex());  // applySlice takes it
+    applySlice(t.client, slice, t.scene.camera());
+  }
   EXPECT_EQ(replica->observations().size(), before);
   EXPECT_LT((replica->position() - p->position()).norm(), 1e-12);
 }
@@ -130,6 +144,7 @@ TEST(SliceRoundTrip, InconsistentFeatureRecordIsRejected) {
   record.id = 12345;
   record.features.depth.resize(3);
   Map replica;
+  MutexLock lock(replica.updateMutex());
   EXPECT_THROW(insertKeyFrameRecord(replica, record, t.scene.camera()), std::invalid_argument);
 }
 

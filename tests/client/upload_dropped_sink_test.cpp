@@ -47,13 +47,13 @@ class DroppedUploadSink : public ::testing::Test {
   }
 
   KeyFrame* keyframe(std::size_t view) {
-    std::lock_guard lock(map.updateMutex());
+    MutexLock lock(map.updateMutex());
     return map.createKeyFrame(view, 0.0, views[view].features, views[view].T_cw);
   }
 
   // A point at scene point `scene_point`, born in `born`, observed by `observers`.
   MapPoint* point(int scene_point, KeyFrame* born, const std::vector<KeyFrame*>& observers) {
-    std::lock_guard lock(map.updateMutex());
+    MutexLock lock(map.updateMutex());
     MapPoint* p = map.createMapPoint(scene.points()[static_cast<std::size_t>(scene_point)], born);
     scene_of[p] = scene_point;
     for (KeyFrame* kf : observers)
@@ -63,12 +63,12 @@ class DroppedUploadSink : public ::testing::Test {
   }
 
   void observe(MapPoint* p, KeyFrame* kf) {
-    std::lock_guard lock(map.updateMutex());
+    MutexLock lock(map.updateMutex());
     map.addObservation(p, kf, indexOf(kf->frameIndex(), scene_of.at(p)));
   }
 
   void connect(std::initializer_list<KeyFrame*> keyframes) {
-    std::lock_guard lock(map.updateMutex());
+    MutexLock lock(map.updateMutex());
     for (KeyFrame* kf : keyframes) map.updateConnections(kf);
   }
 
@@ -117,7 +117,7 @@ TEST_F(DroppedUploadSink, ForgetsTheKeyFrameAndItsOwnPointsButKeepsThoseTheEdgeK
   const KeyFrameId kf2_id = kf2->id();
   EXPECT_TRUE(sink.onUploadDropped(3, kf2_id));
 
-  std::lock_guard lock(map.updateMutex());
+  MutexLock lock(map.updateMutex());
   EXPECT_EQ(map.keyFrame(kf2_id), nullptr);
   EXPECT_TRUE(kf2->isBad());
   for (MapPoint* p : own) EXPECT_TRUE(p->isBad());
@@ -156,13 +156,16 @@ TEST_F(DroppedUploadSink, AnswerOfALaterUploadSettlesTheDroppedOnes) {
 TEST_F(DroppedUploadSink, TheOriginKeepsItsPoseAndAResetIsSaidAgain) {
   sink.onMapReset();
   KeyFrame* kf0 = keyframe(0);
-  ASSERT_EQ(map.originKeyFrame(), kf0);
+  {
+    MutexLock lock(map.updateMutex());
+    ASSERT_EQ(map.originKeyFrame(), kf0);
+  }
   MapPoint* own = point(common[0], kf0, {kf0});
   sink.insertKeyFrame(kf0);
   ASSERT_TRUE(uplink.sent.back().map_reset);
   EXPECT_TRUE(sink.onUploadDropped(uplink.sent.back().sequence, kf0->id()));
   {
-    std::lock_guard lock(map.updateMutex());
+    MutexLock lock(map.updateMutex());
     EXPECT_EQ(map.keyFrame(kf0->id()), kf0);
     EXPECT_TRUE(kf0->isEvicted());
     EXPECT_EQ(map.heldKeyFrameCount(), 0u);

@@ -222,7 +222,7 @@ int main(int argc, char** argv) {
     const StoreSessionId session = store->beginSession("kitchen", small.info());
     MapStoreWriter writer(store, session, small.map, std::make_shared<MapStoreWriteStats>());
     {
-      std::lock_guard lock(small.map.updateMutex());
+      MutexLock lock(small.map.updateMutex());
       writer.onMapChanged(small.map.takeChanges());
     }
     writer.stop();

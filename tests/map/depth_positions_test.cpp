@@ -30,6 +30,7 @@ struct DepthKeyFrame {
 
 TEST(DepthPositions, PointsMadeFromDepthAreRecognisedAndRebuilt) {
   DepthKeyFrame t;
+  MutexLock lock(t.map.updateMutex());
   const std::vector<MapPoint*> points = t.map.mapPoints();
   ASSERT_GT(points.size(), 50u);
   std::vector<MapPointRecord> records;
@@ -48,6 +49,7 @@ TEST(DepthPositions, PointsMadeFromDepthAreRecognisedAndRebuilt) {
 
 TEST(DepthPositions, MovedPointsAndOtherKeyFramesAreNotFlagged) {
   DepthKeyFrame t;
+  MutexLock lock(t.map.updateMutex());
   MapPoint* moved = t.map.mapPoints().front();
   t.map.setPointPosition(moved, moved->position() + Eigen::Vector3d(0.0, 0.0, 0.01));
   EXPECT_FALSE(isDepthBackProjection(*moved, *t.kf, t.scene.camera()));
@@ -60,6 +62,7 @@ TEST(DepthPositions, MovedPointsAndOtherKeyFramesAreNotFlagged) {
 
 TEST(DepthPositions, RebuildRefusesWhatTheKeyFrameCannotGive) {
   DepthKeyFrame t;
+  MutexLock lock(t.map.updateMutex());
   const KeyFrameRecord keyframe = keyFrameRecord(*t.kf);
   MapPointRecord point = mapPointRecord(*t.map.mapPoints().front());
   point.position_from_depth = true;

@@ -52,7 +52,7 @@ std::vector<PointPlan> plan() {
   return out;
 }
 
-std::vector<KeyFrame*> addKeyFrames(Map& map) {
+std::vector<KeyFrame*> addKeyFrames(Map& map) REQUIRES(map.updateMutex()) {
   std::vector<KeyFrame*> out;
   for (std::size_t k = 0; k < kKeyFrames; ++k) {
     auto features = std::make_shared<FrameFeatures>();
@@ -71,7 +71,7 @@ std::array<std::uint8_t, 32> descriptorOf(std::size_t i) {
   return d;
 }
 
-void expectSameMaps(Map& a, Map& b) {
+void expectSameMaps(Map& a, Map& b) REQUIRES(a.updateMutex(), b.updateMutex()) {
   ASSERT_EQ(a.pointCount(), b.pointCount());
   const auto keyframes_a = a.keyFrames();
   const auto keyframes_b = b.keyFrames();
@@ -108,6 +108,8 @@ TEST(MapBulkLoad, LinksTheGraphUpdateConnectionsLinksKeyFrameByKeyFrame) {
   const std::vector<PointPlan> points = plan();
   Map one_by_one;
   Map bulk;
+  MutexLock lock_a(one_by_one.updateMutex());
+  MutexLock lock_b(bulk.updateMutex());
   one_by_one.setChangeRecording(false);
   bulk.setChangeRecording(false);
   const auto keyframes_a = addKeyFrames(one_by_one);
@@ -151,23 +153,27 @@ TEST(MapBulkLoad, LinksTheGraphUpdateConnectionsLinksKeyFrameByKeyFrame) {
   expectSameMaps(one_by_one, bulk);
 }
 
+// Keyframes, then every planned point but the last, one call at a time.
+void addPlannedPoints(Map& map, const std::vector<PointPlan>& points) REQUIRES(map.updateMutex()) {
+  const auto keyframes = addKeyFrames(map);
+  for (std::size_t i = 0; i + 1 < points.size(); ++i) {
+    const PointPlan& p = points[i];
+    MapPoint* point = map.createMapPoint(Eigen::Vector3d(0, 0, 1), keyframes[p.keyframes[0]],
+                                         static_cast<MapPointId>(1000 + i));
+    for (std::size_t j = 0; j < p.keyframes.size(); ++j) {
+      map.addObservation(point, keyframes[p.keyframes[j]], p.keypoints[j]);
+    }
+  }
+}
+
 TEST(MapBulkLoad, UpdatesLinksThatAreThereAlready) {
   const std::vector<PointPlan> points = plan();
   Map once;
   Map twice;
-  const auto keyframes_a = addKeyFrames(once);
-  const auto keyframes_b = addKeyFrames(twice);
-  for (Map* map : {&once, &twice}) {
-    const auto& keyframes = map == &once ? keyframes_a : keyframes_b;
-    for (std::size_t i = 0; i + 1 < points.size(); ++i) {
-      const PointPlan& p = points[i];
-      MapPoint* point = map->createMapPoint(Eigen::Vector3d(0, 0, 1), keyframes[p.keyframes[0]],
-                                            static_cast<MapPointId>(1000 + i));
-      for (std::size_t j = 0; j < p.keyframes.size(); ++j) {
-        map->addObservation(point, keyframes[p.keyframes[j]], p.keypoints[j]);
-      }
-    }
-  }
+  MutexLock lock_a(once.updateMutex());
+  MutexLock lock_b(twice.updateMutex());
+  addPlannedPoints(once, points);
+  addPlannedPoints(twice, points);
   for (KeyFrame* keyframe : once.keyFrames()) once.updateConnections(keyframe);
   for (KeyFrame* keyframe : once.keyFrames()) once.updateConnections(keyframe);
   twice.linkAllConnections();

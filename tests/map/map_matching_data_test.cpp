@@ -104,7 +104,7 @@ SE3d poseOf(int index, const PinholeCamera& camera) {
 
 // A keyframe at `T_cw` with one map point per keypoint that has depth.
 KeyFrame* keyFrameWithDepthPoints(Map& map, int index, const SE3d& T_cw,
-                                  const PinholeCamera& camera) {
+                                  const PinholeCamera& camera) REQUIRES(map.updateMutex()) {
   const RealFrame& rf = realFrame(index);
   KeyFrame* kf =
       map.createKeyFrame(static_cast<std::size_t>(index), index / 30.0, rf.features, T_cw);
@@ -168,6 +168,7 @@ class MapMatchingRealData : public ::testing::Test {
  protected:
   void SetUp() override {
     EDGESLAM_REQUIRE_SHARED(test::kSevenScenesSequence);
+    MutexLock lock(map_.updateMutex());
     kf0_ = keyFrameWithDepthPoints(map_, 0, poseOf(0, camera_), camera_);
   }
 
@@ -288,6 +289,7 @@ TEST_F(MapMatchingRealData, TriangulationPairsAgreeWithDepth) {
   const SE3d T1 = a.T_cw;
   const SE3d T2 = refinedPose(first, second, camera_);
   Map map;
+  MutexLock lock(map.updateMutex());
   KeyFrame* kf1 = map.createKeyFrame(first, first / 30.0, a.features, T1);
   KeyFrame* kf2 = map.createKeyFrame(second, second / 30.0, b.features, T2);
 
@@ -337,6 +339,7 @@ TEST_F(MapMatchingRealData, TriangulationPairsAgreeWithDepth) {
 
   // Keypoints that already have a point take no part.
   Map with_points;
+  MutexLock with_points_lock(with_points.updateMutex());
   KeyFrame* kf1_points = keyFrameWithDepthPoints(with_points, first, T1, camera_);
   KeyFrame* kf2_bare = with_points.createKeyFrame(second, second / 30.0, b.features, T2);
   const auto partial = matchForTriangulation(*kf1_points, *kf2_bare, camera_, true);
@@ -349,6 +352,7 @@ TEST_F(MapMatchingRealData, TriangulationPairsAgreeWithDepth) {
 }
 
 TEST_F(MapMatchingRealData, FuseMergesDuplicatedPoints) {
+  MutexLock lock(map_.updateMutex());
   // Keyframe 10 gets its own points from its depth: duplicates of keyframe 0's.
   KeyFrame* kf10 = keyFrameWithDepthPoints(map_, 10, poseOf(10, camera_), camera_);
   const std::size_t before = map_.pointCount();
@@ -385,11 +389,15 @@ TEST_F(MapMatchingRealData, FuseMergesDuplicatedPoints) {
       "fuse", 11,
       [&] {
         timing_map = std::make_unique<Map>();
+        MutexLock timing_lock(timing_map->updateMutex());
         KeyFrame* k0 = keyFrameWithDepthPoints(*timing_map, 0, poseOf(0, camera_), camera_);
         timing_kf = keyFrameWithDepthPoints(*timing_map, 10, poseOf(10, camera_), camera_);
         timing_points = k0->goodPoints();
       },
-      [&] { fuse(*timing_map, timing_kf, timing_points, camera_); });
+      [&] {
+        MutexLock timing_lock(timing_map->updateMutex());
+        fuse(*timing_map, timing_kf, timing_points, camera_);
+      });
 }
 
 }  // namespace

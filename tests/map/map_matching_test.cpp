@@ -25,6 +25,7 @@ Frame frameFor(const test::SyntheticView& view, const PinholeCamera& camera, std
 class FrustumTest : public ::testing::Test {
  protected:
   void SetUp() override {
+    MutexLock lock(map_.updateMutex());
     // One keypoint at the image centre seeing a point 2 m ahead.
     const PinholeCamera& cam = scene_.camera();
     auto features = std::make_shared<FrameFeatures>();
@@ -87,6 +88,7 @@ TEST_F(FrustumTest, RejectsAnObliqueViewAndAPointOutsideTheImage) {
 }
 
 TEST_F(FrustumTest, BadPointIsNeverInViewAndMissingPoseIsAnError) {
+  MutexLock lock(map_.updateMutex());
   frame_.T_cw.reset();
   EXPECT_THROW(isInFrustum(point_, frame_), std::invalid_argument);
   EXPECT_THROW(isInFrustum(nullptr, frame_), std::invalid_argument);
@@ -122,6 +124,7 @@ class SyntheticMatching : public ::testing::Test {
 };
 
 TEST_F(SyntheticMatching, ByProjectionFindsTheTrueMatches) {
+  MutexLock lock(map_.updateMutex());
   KeyFrame* kf = scene_.addKeyFrame(map_, view1_, 0, true);
   Frame last = frameFor(view1_, scene_.camera(), 0, true);
   last.points = kf->points();
@@ -140,6 +143,7 @@ TEST_F(SyntheticMatching, ByProjectionWithDepthUsesTheRightCoordinate) {
   const auto v1 = scene.view(poseAt({0, 0, 0}), 8, true);
   const auto v2 = scene.view(poseAt({0.05, 0, 0.3}), 8, true);  // moving forward 30 cm
   Map map;
+  MutexLock lock(map.updateMutex());
   KeyFrame* kf = scene.addKeyFrame(map, v1, 0, true);
   Frame last = frameFor(v1, scene.camera(), 0, true);
   last.points = kf->points();
@@ -154,6 +158,7 @@ TEST_F(SyntheticMatching, ByProjectionWithDepthUsesTheRightCoordinate) {
 }
 
 TEST_F(SyntheticMatching, LocalPointsNeedTheFrustumTestAndSkipMatchedPoints) {
+  MutexLock lock(map_.updateMutex());
   KeyFrame* kf = scene_.addKeyFrame(map_, view1_, 0, true);
   const std::vector<MapPoint*> points = kf->goodPoints();
   Frame frame = frameFor(view2_, scene_.camera(), 1, true);
@@ -170,6 +175,7 @@ TEST_F(SyntheticMatching, LocalPointsNeedTheFrustumTestAndSkipMatchedPoints) {
 }
 
 TEST_F(SyntheticMatching, KeyFrameByDescriptorNeedsNoPose) {
+  MutexLock lock(map_.updateMutex());
   KeyFrame* kf = scene_.addKeyFrame(map_, view1_, 0, true);
   Frame frame = frameFor(view2_, scene_.camera(), 1, false);
   const int matches = matchKeyFrameByDescriptor(*kf, frame);
@@ -179,6 +185,7 @@ TEST_F(SyntheticMatching, KeyFrameByDescriptorNeedsNoPose) {
 }
 
 TEST_F(SyntheticMatching, KeyFrameByProjectionSkipsAlreadyMatchedPoints) {
+  MutexLock lock(map_.updateMutex());
   KeyFrame* kf = scene_.addKeyFrame(map_, view1_, 0, true);
   const std::vector<MapPoint*> good = kf->goodPoints();
   const std::vector<MapPoint*> first_half(good.begin(), good.begin() + good.size() / 2);
@@ -192,6 +199,7 @@ TEST_F(SyntheticMatching, KeyFrameByProjectionSkipsAlreadyMatchedPoints) {
 }
 
 TEST_F(SyntheticMatching, TriangulationPairsAreTheTrueCorrespondences) {
+  MutexLock lock(map_.updateMutex());
   KeyFrame* kf1 = scene_.addKeyFrame(map_, view1_, 0, false);
   KeyFrame* kf2 = scene_.addKeyFrame(map_, view2_, 1, false);
   const auto pairs = matchForTriangulation(*kf1, *kf2, scene_.camera(), true);
@@ -202,6 +210,7 @@ TEST_F(SyntheticMatching, TriangulationPairsAreTheTrueCorrespondences) {
 }
 
 TEST_F(SyntheticMatching, TriangulationSkipsKeypointsThatHaveAPoint) {
+  MutexLock lock(map_.updateMutex());
   KeyFrame* kf1 = scene_.addKeyFrame(map_, view1_, 0, true);
   KeyFrame* kf2 = scene_.addKeyFrame(map_, view2_, 1, false);
   EXPECT_TRUE(matchForTriangulation(*kf1, *kf2, scene_.camera(), true).empty());
@@ -209,6 +218,7 @@ TEST_F(SyntheticMatching, TriangulationSkipsKeypointsThatHaveAPoint) {
 }
 
 TEST_F(SyntheticMatching, TriangulationWithoutBaselineGivesNothing) {
+  MutexLock lock(map_.updateMutex());
   KeyFrame* kf1 = scene_.addKeyFrame(map_, view1_, 0, false);
   const auto same_place = scene_.view(poseAt({0, 0, 0}, 0.05), 8, false);
   KeyFrame* kf2 = scene_.addKeyFrame(map_, same_place, 1, false);
@@ -216,6 +226,7 @@ TEST_F(SyntheticMatching, TriangulationWithoutBaselineGivesNothing) {
 }
 
 TEST_F(SyntheticMatching, TriangulationRejectsDescriptorsTooFarApart) {
+  MutexLock lock(map_.updateMutex());
   const auto noisy = scene_.view(view2_.T_cw, 100, false);  // ~80 bits differ: above 50
   KeyFrame* kf1 = scene_.addKeyFrame(map_, view1_, 0, false);
   KeyFrame* kf2 = scene_.addKeyFrame(map_, noisy, 1, false);
@@ -224,6 +235,7 @@ TEST_F(SyntheticMatching, TriangulationRejectsDescriptorsTooFarApart) {
 }
 
 TEST_F(SyntheticMatching, FuseMergesDuplicatesAndAddsObservations) {
+  MutexLock lock(map_.updateMutex());
   KeyFrame* kf1 = scene_.addKeyFrame(map_, view1_, 0, true);
   KeyFrame* kf2 = scene_.addKeyFrame(map_, view2_, 1, true);
   // Leave half of kf2's keypoints without a point: those gain an observation instead.
@@ -261,6 +273,7 @@ TEST(MapMatchingEdgeCases, EmptyFramesAndNoPoints) {
   SyntheticScene scene(200, 3);
   const auto view = scene.view(SE3d(), 4, false);
   Map map;
+  MutexLock lock(map.updateMutex());
   KeyFrame* with_points = scene.addKeyFrame(map, view, 0, true);
   KeyFrame* without_points = scene.addKeyFrame(map, view, 1, false);
   KeyFrame* empty_kf = map.createKeyFrame(2, 0.0, test::emptyFeatures(camera), SE3d());
@@ -304,6 +317,7 @@ TEST(MapMatchingEdgeCases, MissingPoseOrCameraIsAClearError) {
   SyntheticScene scene(50, 4);
   const auto view = scene.view(SE3d(), 4, false);
   Map map;
+  MutexLock lock(map.updateMutex());
   KeyFrame* kf = scene.addKeyFrame(map, view, 0, true);
   Frame posed(1, 0.0, view.features, &camera);
   posed.T_cw = SE3d();

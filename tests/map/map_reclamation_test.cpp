@@ -43,20 +43,20 @@ TEST(MapReclamation, AnErasedPointWaitsForEveryParticipantsQuiescentPoint) {
   ThreeKeyFrames t;
   MapParticipant tracking(t.map, "tracking");
   MapParticipant mapping(t.map, "mapping");
-  std::lock_guard lock(t.map.updateMutex());
+  MutexLock lock(t.map.updateMutex());
   const std::size_t points = t.map.pointCount();
   ASSERT_GT(points, 10u);
   MapPoint* erased = t.kf1->goodPoints().front();
   t.map.erasePoint(erased);
   EXPECT_EQ(t.map.reclamation().points_waiting, 1u);
 
-  tracking.quiescent();
+  tracking.quiescent(t.map);
   // The mapping participant may still hold it: still allocated, still marked bad.
   EXPECT_TRUE(erased->isBad());
   EXPECT_EQ(t.map.reclamation().points_waiting, 1u);
   EXPECT_EQ(t.map.reclamation().points_freed, 0u);
 
-  mapping.quiescent();
+  mapping.quiescent(t.map);
   EXPECT_EQ(t.map.reclamation().points_waiting, 0u);
   EXPECT_EQ(t.map.reclamation().points_freed, 1u);
   EXPECT_EQ(t.map.pointCount(), points - 1);
@@ -65,13 +65,13 @@ TEST(MapReclamation, AnErasedPointWaitsForEveryParticipantsQuiescentPoint) {
 TEST(MapReclamation, ErasuresAfterAQuiescentPointWaitForTheNextOne) {
   ThreeKeyFrames t;
   MapParticipant mapping(t.map, "mapping");
-  std::lock_guard lock(t.map.updateMutex());
+  MutexLock lock(t.map.updateMutex());
   t.map.erasePoint(t.kf0->goodPoints().front());
-  mapping.quiescent();
+  mapping.quiescent(t.map);
   t.map.erasePoint(t.kf0->goodPoints().front());
   EXPECT_EQ(t.map.reclamation().points_freed, 1u);
   EXPECT_EQ(t.map.reclamation().points_waiting, 1u);
-  mapping.quiescent();
+  mapping.quiescent(t.map);
   EXPECT_EQ(t.map.reclamation().points_freed, 2u);
 }
 
@@ -80,19 +80,20 @@ TEST(MapReclamation, ParticipantThatLeavesNoLongerHoldsAnythingBack) {
   MapParticipant tracking(t.map, "tracking");
   {
     MapParticipant global_ba(t.map, "global BA");
-    std::lock_guard lock(t.map.updateMutex());
+    MutexLock lock(t.map.updateMutex());
     t.map.erasePoint(t.kf2->goodPoints().front());
-    tracking.quiescent();
+    tracking.quiescent(t.map);
     EXPECT_EQ(t.map.reclamation().points_freed, 0u);
     EXPECT_EQ(t.map.reclamation().participants, 2u);
   }
-  std::lock_guard lock(t.map.updateMutex());
+  MutexLock lock(t.map.updateMutex());
   EXPECT_EQ(t.map.reclamation().points_freed, 1u);
   EXPECT_EQ(t.map.reclamation().participants, 1u);
 }
 
 TEST(MapReclamation, WithoutParticipantsErasedElementsStayUntilTheMapGoes) {
   ThreeKeyFrames t;
+  MutexLock lock(t.map.updateMutex());
   t.map.erasePoint(t.kf0->goodPoints().front());
   t.map.eraseKeyFrame(t.kf1);
   EXPECT_EQ(t.map.reclamation().points_freed, 0u);
@@ -103,12 +104,12 @@ TEST(MapReclamation, WithoutParticipantsErasedElementsStayUntilTheMapGoes) {
 TEST(MapReclamation, AnErasedKeyFrameDropsItsFeaturesButKeepsItsPoseInTheTree) {
   ThreeKeyFrames t;
   MapParticipant tracking(t.map, "tracking");
-  std::lock_guard lock(t.map.updateMutex());
+  MutexLock lock(t.map.updateMutex());
   const SE3d pose_before = t.kf1->pose();
   const int scale_levels = t.kf1->features().scales.numLevels();
   t.map.eraseKeyFrame(t.kf1);
   ASSERT_TRUE(t.kf1->isBad());
-  tracking.quiescent();
+  tracking.quiescent(t.map);
   EXPECT_EQ(t.map.reclamation().keyframes_released, 1u);
   EXPECT_EQ(t.kf1->features().size(), 0u);
   EXPECT_TRUE(t.kf1->points().empty());

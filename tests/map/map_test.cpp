@@ -36,6 +36,7 @@ struct TwoKeyFrames {
 
 TEST(Map, RecordsCreationsAndForgetsPointsBornAndDeadInOneSlice) {
   TwoKeyFrames t;
+  MutexLock lock(t.map.updateMutex());
   MapChanges first = t.map.takeChanges();
   EXPECT_EQ(first.keyframes_created.size(), 2u);
   EXPECT_EQ(first.points_created.size(), t.map.pointCount());
@@ -71,6 +72,7 @@ TEST(Map, ObservationsLinkBothWaysAndCovisibilityIsSymmetric) {
 
 TEST(Map, AMonocularPointWithOneObservationLeftIsErased) {
   TwoKeyFrames t;
+  MutexLock lock(t.map.updateMutex());
   MapPoint* p = t.shared.front();
   const MapPointId id = p->id();
   t.map.eraseObservation(p, t.kf1);
@@ -81,6 +83,7 @@ TEST(Map, AMonocularPointWithOneObservationLeftIsErased) {
 
 TEST(Map, ReplacePointMovesObservations) {
   TwoKeyFrames t;
+  MutexLock lock(t.map.updateMutex());
   MapPoint* other = t.shared[1];
   const int scene_point = t.scene.sceneOf(other);
   // A third keyframe sees the same scene point and made its own (duplicate) point for it.
@@ -102,6 +105,7 @@ TEST(Map, ReplacePointMovesObservations) {
 
 TEST(Map, ErasedKeyFrameFollowsItsParentsLaterCorrection) {
   TwoKeyFrames t;
+  MutexLock lock(t.map.updateMutex());
   t.map.takeChanges();  // the keyframe reached the other side before it is erased
   KeyFrame* kf1 = t.kf1;
   const SE3d before = kf1->pose();
@@ -122,12 +126,14 @@ TEST(Map, ErasedKeyFrameFollowsItsParentsLaterCorrection) {
 
 TEST(Map, TheOriginKeyFrameIsNeverErased) {
   TwoKeyFrames t;
+  MutexLock lock(t.map.updateMutex());
   t.map.eraseKeyFrame(t.kf0);
   EXPECT_FALSE(t.kf0->isBad());
 }
 
 TEST(Map, ClearEmptiesButIdsKeepGrowing) {
   TwoKeyFrames t;
+  MutexLock lock(t.map.updateMutex());
   const KeyFrameId last = t.kf1->id();
   t.map.clear();
   EXPECT_EQ(t.map.keyFrameCount(), 0u);

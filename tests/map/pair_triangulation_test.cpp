@@ -52,6 +52,7 @@ Eigen::Vector2d pixelOf(const PinholeCamera& camera, const SE3d& T_cw, const Eig
 TEST(PairTriangulation, SceneSeenFromTwoKeyFramesComesBack) {
   test::SyntheticScene scene(300, 5);
   Map map;
+  MutexLock lock(map.updateMutex());
   const auto v1 = scene.view(poseAt({0, 0, 0}), 0, false);
   const auto v2 = scene.view(poseAt({0.3, 0.05, 0}, 0.05), 0, false);
   KeyFrame* kf1 = scene.addKeyFrame(map, v1, 0, false);
@@ -162,6 +163,7 @@ TEST(PairTriangulation, DepthStandsInForMissingParallax) {
   // RGB-D: with almost no baseline the keypoint's depth gives the point.
   test::SyntheticScene scene(100, 9);
   Map map;
+  MutexLock lock(map.updateMutex());
   const auto v1 = scene.view(poseAt({0, 0, 0}), 0, true);
   const auto v2 = scene.view(poseAt({0, 0, 0.005}), 0, true);
   KeyFrame* kf1 = scene.addKeyFrame(map, v1, 0, false);

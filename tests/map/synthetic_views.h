@@ -107,7 +107,7 @@ class SyntheticScene {
 
   // A keyframe for `view` with one map point per keypoint at the true scene position.
   KeyFrame* addKeyFrame(Map& map, const SyntheticView& view, std::size_t frame_index,
-                        bool with_points) {
+                        bool with_points) REQUIRES(map.updateMutex()) {
     KeyFrame* kf = map.createKeyFrame(frame_index, 0.0, view.features, view.T_cw);
     if (!with_points) return kf;
     for (std::size_t i = 0; i < view.scene_point.size(); ++i) {

@@ -119,6 +119,7 @@ class TriangulationByBowRealData : public ::testing::Test {
     EDGESLAM_REQUIRE_SHARED(test::kSevenScenesSequence);
     const RealFrame& a = realFrame(kFirst);
     const RealFrame& b = realFrame(kSecond);
+    MutexLock lock(map_.updateMutex());
     kf1_ = map_.createKeyFrame(kFirst, kFirst / 30.0, a.features, a.T_cw);
     kf2_ = map_.createKeyFrame(kSecond, kSecond / 30.0, b.features, b.T_cw);
   }

@@ -52,6 +52,7 @@ class TriangulationByBow : public ::testing::Test {
 };
 
 TEST_F(TriangulationByBow, FindsTheTrueCorrespondencesUnderSharedNodes) {
+  MutexLock lock(map_.updateMutex());
   KeyFrame* kf1 = scene_.addKeyFrame(map_, view1_, 0, false);
   KeyFrame* kf2 = scene_.addKeyFrame(map_, view2_, 1, false);
   kf1->setPlace(placeOf(view1_, 0));
@@ -68,6 +69,7 @@ TEST_F(TriangulationByBow, FindsTheTrueCorrespondencesUnderSharedNodes) {
 }
 
 TEST_F(TriangulationByBow, ComparesOnlyKeypointsUnderTheSameNode) {
+  MutexLock lock(map_.updateMutex());
   KeyFrame* kf1 = scene_.addKeyFrame(map_, view1_, 0, false);
   KeyFrame* kf2 = scene_.addKeyFrame(map_, view2_, 1, false);
   kf1->setPlace(placeOf(view1_, 0));
@@ -78,6 +80,7 @@ TEST_F(TriangulationByBow, ComparesOnlyKeypointsUnderTheSameNode) {
 }
 
 TEST_F(TriangulationByBow, FallsBackToTheBandSearchWithoutComparableDirectIndexes) {
+  MutexLock lock(map_.updateMutex());
   KeyFrame* kf1 = scene_.addKeyFrame(map_, view1_, 0, false);
   KeyFrame* kf2 = scene_.addKeyFrame(map_, view2_, 1, false);
   const auto by_band = matchForTriangulation(*kf1, *kf2, scene_.camera(), true);
@@ -102,6 +105,7 @@ TEST_F(TriangulationByBow, FallsBackToTheBandSearchWithoutComparableDirectIndexe
 }
 
 TEST_F(TriangulationByBow, SkipsKeypointsThatHaveAPoint) {
+  MutexLock lock(map_.updateMutex());
   KeyFrame* kf1 = scene_.addKeyFrame(map_, view1_, 0, true);
   KeyFrame* kf2 = scene_.addKeyFrame(map_, view2_, 1, false);
   kf1->setPlace(placeOf(view1_, 0));
@@ -111,6 +115,7 @@ TEST_F(TriangulationByBow, SkipsKeypointsThatHaveAPoint) {
 }
 
 TEST_F(TriangulationByBow, NoBaselineGivesNothing) {
+  MutexLock lock(map_.updateMutex());
   KeyFrame* kf1 = scene_.addKeyFrame(map_, view1_, 0, false);
   const SyntheticView same_place = scene_.view(poseAt({0, 0, 0}, 0.05), 8, false);
   KeyFrame* kf2 = scene_.addKeyFrame(map_, same_place, 1, false);
@@ -120,6 +125,7 @@ TEST_F(TriangulationByBow, NoBaselineGivesNothing) {
 }
 
 TEST_F(TriangulationByBow, ADirectIndexNamingMissingKeypointsIsAClearError) {
+  MutexLock lock(map_.updateMutex());
   KeyFrame* kf1 = scene_.addKeyFrame(map_, view1_, 0, false);
   KeyFrame* kf2 = scene_.addKeyFrame(map_, view2_, 1, false);
   kf1->setPlace(placeOf(view1_, 0));

@@ -48,10 +48,12 @@ struct UploadFixture {
     insertKeyFrameRecord(edge, keyFrameRecord(*origin), scene.camera());
   }
 
-  void edgeReceivesOlder() { insertKeyFrameRecord(edge, keyFrameRecord(*older), scene.camera()); }
+  void edgeReceivesOlder() REQUIRES(edge.updateMutex()) {
+    insertKeyFrameRecord(edge, keyFrameRecord(*older), scene.camera());
+  }
 
   // As EdgeMapSession applies an upload: without recording, then the conflicts with recording.
-  std::optional<UploadedPointConflict> upload() {
+  std::optional<UploadedPointConflict> upload() REQUIRES(edge.updateMutex()) {
     edge.takeChanges();
     edge.setChangeRecording(false);
     insertKeyFrameRecord(edge, keyFrameRecord(*uploaded), scene.camera());
@@ -64,6 +66,7 @@ struct UploadFixture {
 
 TEST(UploadedPoint, ObservationInTheOlderKeyFrameIsApplied) {
   UploadFixture t;
+  MutexLock lock(t.edge.updateMutex());
   t.edgeReceivesOlder();
   EXPECT_FALSE(t.upload().has_value());
   const MapPoint* p = t.edge.mapPoint(t.triangulated->id());
@@ -78,6 +81,7 @@ TEST(UploadedPoint, ObservationInTheOlderKeyFrameIsApplied) {
 
 TEST(UploadedPoint, KeypointHoldingTheEdgesOwnPointMergesIntoIt) {
   UploadFixture t;
+  MutexLock lock(t.edge.updateMutex());
   t.edgeReceivesOlder();
   // The edge triangulated that keypoint itself before the client heard of it.
   KeyFrame* older_on_edge = t.edge.keyFrame(t.older->id());
@@ -101,6 +105,7 @@ TEST(UploadedPoint, KeypointHoldingTheEdgesOwnPointMergesIntoIt) {
 
 TEST(UploadedPoint, PointLeftWithOneObservationIsErasedAndTheErasureRecorded) {
   UploadFixture t;  // the older keyframe never reaches the edge (culled there meanwhile)
+  MutexLock lock(t.edge.updateMutex());
   const auto conflict = t.upload();
   ASSERT_TRUE(conflict.has_value());
   EXPECT_EQ(conflict->occupant, nullptr);
@@ -112,6 +117,7 @@ TEST(UploadedPoint, PointLeftWithOneObservationIsErasedAndTheErasureRecorded) {
 TEST(UploadedPoint, ObservationInALaterKeyFrameWaitsForIt) {
   // The client's first keyframe upload carries points the second keyframe sees too.
   UploadFixture t;
+  MutexLock lock(t.edge.updateMutex());
   t.edge.takeChanges();
   t.edge.setChangeRecording(false);
   insertKeyFrameRecord(t.edge, keyFrameRecord(*t.older), t.scene.camera());

@@ -41,7 +41,7 @@ struct Corridor {
 
   // A new keyframe seeing points [first, first + span) (a revisit when they exist already), with
   // its covisibility links on both sides.
-  KeyFrame* addKeyFrame(int first) {
+  KeyFrame* addKeyFrame(int first) REQUIRES(map.updateMutex()) {
     const std::size_t end = static_cast<std::size_t>(first + kSpan);
     if (points.size() < end) points.resize(end, nullptr);
     const double x = 0.1 * first / kStep;
@@ -66,7 +66,7 @@ struct Corridor {
   KeyFrameId id(int k) const { return keyframes[static_cast<std::size_t>(k)]->id(); }
 
   // A replica holding everything, built from records as the client would receive them.
-  void replicateInto(Map& replica) const {
+  void replicateInto(Map& replica) const REQUIRES(map.updateMutex(), replica.updateMutex()) {
     for (KeyFrame* kf : keyframes) insertKeyFrameRecord(replica, keyFrameRecord(*kf), camera);
     for (MapPoint* p : map.mapPoints()) {
       upsertPointRecord(replica, mapPointRecord(*p), keyframes.back()->id());

@@ -39,6 +39,7 @@ class LocalMapperBow : public ::testing::Test {
 
   // kf1 and kf2 share the points of the even scene points; the odd ones are left to triangulate.
   void makeKeyFrames() {
+    MutexLock lock(map_.updateMutex());
     kf1_ = scene_.addKeyFrame(map_, view1_, 0, false);
     kf2_ = scene_.addKeyFrame(map_, view2_, 1, false);
     for (std::size_t i = 0; i < view1_.scene_point.size(); ++i) {
@@ -52,6 +53,11 @@ class LocalMapperBow : public ::testing::Test {
       map_.refreshPoint(p);
     }
     map_.updateConnections(kf1_);
+  }
+
+  std::size_t pointCount() const {
+    MutexLock lock(map_.updateMutex());
+    return map_.pointCount();
   }
 
   LocalMapperStats mapSecondKeyFrame(const LocalMapperOptions& options) {
@@ -82,7 +88,7 @@ class LocalMapperBow : public ::testing::Test {
 
 TEST_F(LocalMapperBow, DescribesKeyFramesAndTriangulatesThroughTheDirectIndex) {
   makeKeyFrames();
-  const std::size_t points_before = map_.pointCount();
+  const std::size_t points_before = pointCount();
   const LocalMapperStats stats =
       mapSecondKeyFrame(options(TriangulationSearch::kBagOfWords, vocabulary_));
 
@@ -98,7 +104,7 @@ TEST_F(LocalMapperBow, DescribesKeyFramesAndTriangulatesThroughTheDirectIndex) {
   EXPECT_GT(stats.triangulation_pairs, 100u);
   // About half of the scene points seen by both keyframes had no point yet.
   EXPECT_GT(stats.points_created, 100u);
-  EXPECT_GT(map_.pointCount(), points_before + 100);
+  EXPECT_GT(pointCount(), points_before + 100);
 
   // Loop detection takes the description the mapper made.
   LoopDetector detector(vocabulary_);
@@ -111,7 +117,10 @@ TEST_F(LocalMapperBow, BandSearchOnRequestOrWithoutAVocabulary) {
   for (const auto& [search, vocabulary] :
        {std::pair{TriangulationSearch::kEpipolarBand, vocabulary_},
         std::pair{TriangulationSearch::kBagOfWords, std::shared_ptr<const Vocabulary>()}}) {
-    map_.clear();
+    {
+      MutexLock lock(map_.updateMutex());
+      map_.clear();
+    }
     makeKeyFrames();
     const LocalMapperStats stats = mapSecondKeyFrame(options(search, vocabulary));
     EXPECT_EQ(kf2_->place(), nullptr);

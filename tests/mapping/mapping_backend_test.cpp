@@ -148,7 +148,7 @@ TEST(MappingBackend, UnthreadedSegmentsAndMapsOnTheCallersThreadWithItsHooks) {
   KeyFrame* keyframe = nullptr;
   std::size_t points = 0;
   {
-    std::lock_guard lock(map.updateMutex());
+    MutexLock lock(map.updateMutex());
     keyframe = scene.addKeyFrame(map, scene.view(test::poseAt({0, 0, 0}), 0, true), 0, true);
     points = map.pointCount();
   }

@@ -19,6 +19,7 @@ TEST(MovablePoints, ErasesThePointsSeenInsideTheMaskOnly) {
   }
   features->descriptors = cv::Mat::zeros(4, 32, CV_8U);
   Map map;
+  MutexLock lock(map.updateMutex());
   KeyFrame* keyframe = map.createKeyFrame(0, 0.0, features, SE3d());
   std::vector<MapPoint*> points;
   for (std::size_t i = 0; i < 4; ++i) {

@@ -40,11 +40,14 @@ class NothingSegmenter : public Segmenter {
 int niceOfMappingThread(std::shared_ptr<Segmenter> segmenter) {
   test::SyntheticScene scene(150, 5);
   Map client(1);
-  KeyFrame* keyframe = scene.addKeyFrame(client, scene.view(poseAt({0, 0, 0}), 0, true), 0, true);
   KeyFrameUpload upload;
-  upload.sequence = 1;
-  upload.keyframe = keyFrameRecord(*keyframe);
-  for (MapPoint* p : keyframe->goodPoints()) upload.new_points.push_back(mapPointRecord(*p));
+  {
+    MutexLock lock(client.updateMutex());
+    KeyFrame* keyframe = scene.addKeyFrame(client, scene.view(poseAt({0, 0, 0}), 0, true), 0, true);
+    upload.sequence = 1;
+    upload.keyframe = keyFrameRecord(*keyframe);
+    for (MapPoint* p : keyframe->goodPoints()) upload.new_points.push_back(mapPointRecord(*p));
+  }
 
   EdgeMapSessionOptions options;
   options.backend.segmenter = std::move(segmenter);

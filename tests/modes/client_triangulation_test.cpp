@@ -107,8 +107,8 @@ EdgeRun runKitti(std::size_t frames, std::size_t lag, bool client_triangulation)
 void expectClientReplicatesEdge(EdgeRun& run) {
   Map& edge = run.link->session().map();
   const Map& client = run.slam->map();
-  std::lock_guard edge_lock(edge.updateMutex());
-  std::lock_guard client_lock(client.updateMutex());
+  MutexLock edge_lock(edge.updateMutex());
+  MutexLock client_lock(client.updateMutex());
   EXPECT_EQ(client.keyFrameCount(), edge.keyFrameCount());
   EXPECT_EQ(client.pointCount(), edge.pointCount());
   for (MapPoint* p : edge.mapPoints()) {
@@ -123,7 +123,7 @@ void expectClientReplicatesEdge(EdgeRun& run) {
 // keyframe after the two the monocular initialisation made, seen twice or more.
 std::size_t clientTriangulatedPointsOnTheEdge(EdgeRun& run) {
   Map& edge = run.link->session().map();
-  std::lock_guard lock(edge.updateMutex());
+  MutexLock lock(edge.updateMutex());
   const std::vector<KeyFrame*> keyframes = edge.keyFrames();
   if (keyframes.size() < 2) return 0;
   const KeyFrameId second = keyframes[1]->id();

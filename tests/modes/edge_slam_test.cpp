@@ -30,22 +30,26 @@ TEST(EdgeSlam, ClientMapReplicatesTheEdgeMapOnKitti) {
     raw_link->flush();
   }
   slam.finish();
+  // What the edge reported in its last slice, and the client's keyframes: these may take the
+  // client map's mutex, so before the test holds it.
+  const std::size_t reported_keyframes = slam.keyFrameCount();
+  const std::size_t reported_points = slam.mapPointCount();
+  const Trajectory client_keyframes = slam.keyframeTrajectory();
   Map& edge = raw_link->session().map();
-  std::lock_guard edge_lock(edge.updateMutex());
+  MutexLock edge_lock(edge.updateMutex());
+  MutexLock client_lock(slam.map().updateMutex());
   EXPECT_GT(edge.pointCount(), 300u);
   EXPECT_EQ(slam.map().keyFrameCount(), edge.keyFrameCount());
   EXPECT_EQ(slam.map().heldKeyFrameCount(), edge.keyFrameCount());
   EXPECT_EQ(slam.map().pointCount(), edge.pointCount());
-  // What the edge reported in its last slice.
-  EXPECT_EQ(slam.keyFrameCount(), edge.keyFrameCount());
-  EXPECT_EQ(slam.mapPointCount(), edge.pointCount());
+  EXPECT_EQ(reported_keyframes, edge.keyFrameCount());
+  EXPECT_EQ(reported_points, edge.pointCount());
   for (MapPoint* p : edge.mapPoints()) {
     const MapPoint* replica = slam.map().mapPoint(p->id());
     ASSERT_NE(replica, nullptr) << "edge point " << p->id() << " missing on the client";
     EXPECT_LT((replica->position() - p->position()).norm(), 1e-9);
     EXPECT_EQ(replica->observations().size(), p->observations().size());
   }
-  const Trajectory client_keyframes = slam.keyframeTrajectory();
   std::size_t compared = 0;
   for (const auto& pose : client_keyframes) {
     for (KeyFrame* kf : edge.keyFrames()) {
@@ -91,9 +95,9 @@ TEST(EdgeSlam, BoundedClientMapHoldsTheEdgeWindowOnKitti) {
   EXPECT_EQ(system.adaptation(), nullptr);  // an in-process link does not adapt
   EdgeMapSession& session = raw_link->session();
   Map& edge = session.map();
-  std::lock_guard edge_lock(edge.updateMutex());
-  std::lock_guard client_lock(slam.map().updateMutex());
+  MutexLock edge_lock(edge.updateMutex());
   const Map& client = slam.map();
+  MutexLock client_lock(client.updateMutex());
   const std::set<KeyFrameId>& held = session.clientWindow().held();
   ASSERT_GT(edge.keyFrameCount(), held.size()) << "the run must leave the window";
   EXPECT_LE(held.size(), session.clientWindow().keepSize());

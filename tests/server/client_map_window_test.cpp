@@ -54,6 +54,7 @@ std::set<int> range(int first, int last) {
 
 TEST(KeyFrameNeighbourhood, BreadthFirstFromTheCentreStrongestLinksFirst) {
   test::Corridor c(20);
+  MutexLock lock(c.map.updateMutex());
   // kf 10 links to 9 and 11 (30 shared points), 8 and 12 (20); 9 then adds 7.
   const auto six = keyFrameNeighbourhood(c.map, c.keyframes[10], 6, 0);
   EXPECT_THAT(indices(c, six), ElementsAre(10, 9, 11, 8, 12, 7));
@@ -68,6 +69,7 @@ TEST(KeyFrameNeighbourhood, BreadthFirstFromTheCentreStrongestLinksFirst) {
 
 TEST(KeyFrameNeighbourhood, TheMostRecentKeyFramesComeWithTheCentre) {
   test::Corridor c(20);
+  MutexLock lock(c.map.updateMutex());
   const auto chosen = keyFrameNeighbourhood(c.map, c.keyframes[5], 6, 2);
   EXPECT_THAT(indices(c, chosen), ElementsAre(5, 19, 18, 4, 6, 3));
 }
@@ -84,7 +86,7 @@ class ClientMapWindowTest : public ::testing::Test {
     o.recent_share = 0.0;
     return o;
   }
-  MapSlice shapeAround(int centre) {
+  MapSlice shapeAround(int centre) REQUIRES(c_.map.updateMutex()) {
     MapSlice slice;
     window_.shape(c_.map, c_.keyframes[static_cast<std::size_t>(centre)], slice);
     return slice;
@@ -95,6 +97,7 @@ class ClientMapWindowTest : public ::testing::Test {
 };
 
 TEST_F(ClientMapWindowTest, EvictsWhatLeavesTheLargerWindowOnly) {
+  MutexLock lock(c_.map.updateMutex());
   EXPECT_EQ(window_.keepSize(), 9u);
   MapSlice slice = shapeAround(29);
   // Keep window around the newest keyframe 29: 21..29; everything older is evicted, nothing sent.
@@ -114,6 +117,7 @@ TEST_F(ClientMapWindowTest, EvictsWhatLeavesTheLargerWindowOnly) {
 }
 
 TEST_F(ClientMapWindowTest, RevisitSendsKeyFramesAndOnlyThePointsTheClientLacks) {
+  MutexLock lock(c_.map.updateMutex());
   shapeAround(29);
   window_.clientHolds(c_.addKeyFrame(300)->id());
   shapeAround(30);  // holds 22..30
@@ -141,6 +145,7 @@ TEST_F(ClientMapWindowTest, RevisitSendsKeyFramesAndOnlyThePointsTheClientLacks)
 }
 
 TEST_F(ClientMapWindowTest, AtMostSoManyKeyFramesComeBackPerSlice) {
+  MutexLock lock(c_.map.updateMutex());
   ClientMapWindowOptions o = options();
   o.max_entering_per_slice = 2;
   window_ = ClientMapWindow(o);
@@ -155,6 +160,7 @@ TEST_F(ClientMapWindowTest, AtMostSoManyKeyFramesComeBackPerSlice) {
 }
 
 TEST_F(ClientMapWindowTest, NewerKeyFramesThanTheCentreStay) {
+  MutexLock lock(c_.map.updateMutex());
   // The client's newest keyframes may still be queued for mapping: never evicted.
   const MapSlice slice = shapeAround(5);
   const std::vector<int> evicted = indices(c_, slice.keyframes_evicted);
@@ -163,6 +169,7 @@ TEST_F(ClientMapWindowTest, NewerKeyFramesThanTheCentreStay) {
 }
 
 TEST_F(ClientMapWindowTest, PointRecordsOnlyForPointsAHeldKeyFrameSees) {
+  MutexLock lock(c_.map.updateMutex());
   shapeAround(29);  // holds 21..29: points 210..329
   MapSlice slice;
   for (int i : {5, 205, 215, 320}) slice.points_upserted.push_back(mapPointRecord(*c_.point(i)));
@@ -177,6 +184,7 @@ TEST_F(ClientMapWindowTest, PointRecordsOnlyForPointsAHeldKeyFrameSees) {
 }
 
 TEST_F(ClientMapWindowTest, ErasedKeyFramesAreNoLongerHeldNorEvicted) {
+  MutexLock lock(c_.map.updateMutex());
   MapSlice slice;
   slice.keyframes_erased = {c_.id(3)};
   c_.map.eraseKeyFrame(c_.keyframes[3]);
@@ -189,6 +197,7 @@ TEST_F(ClientMapWindowTest, ErasedKeyFramesAreNoLongerHeldNorEvicted) {
 
 TEST(ClientMapWindow, UnboundedLeavesTheSliceAlone) {
   test::Corridor c(10);
+  MutexLock lock(c.map.updateMutex());
   ClientMapWindow window;
   EXPECT_FALSE(window.bounded());
   MapSlice slice;

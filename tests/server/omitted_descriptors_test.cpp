@@ -57,6 +57,7 @@ SecondView secondView(test::SyntheticScene& scene, const test::SyntheticView& fi
 TEST(OmittedDescriptors, RowsTakeThePointsDescriptorAndAVanishedPointsKeypointLosesItsPoint) {
   test::SyntheticScene scene(80, 3);
   Map map;
+  MutexLock lock(map.updateMutex());
   const test::SyntheticView first_view = scene.view(poseAt({0, 0, 0}), 0, true);
   KeyFrame* first = scene.addKeyFrame(map, first_view, 0, true);
   SecondView second = secondView(scene, first_view, *first);
@@ -86,6 +87,7 @@ TEST(OmittedDescriptors, RowsTakeThePointsDescriptorAndAVanishedPointsKeypointLo
 TEST(OmittedDescriptors, FlagsThatContradictTheRecordAreRefused) {
   test::SyntheticScene scene(80, 3);
   Map map;
+  MutexLock lock(map.updateMutex());
   const test::SyntheticView first_view = scene.view(poseAt({0, 0, 0}), 0, true);
   KeyFrame* first = scene.addKeyFrame(map, first_view, 0, true);
   const SecondView second = secondView(scene, first_view, *first);
@@ -108,6 +110,7 @@ TEST(OmittedDescriptors, FlagsThatContradictTheRecordAreRefused) {
 TEST(OmittedDescriptors, EdgeSessionFillsUploadedKeyFrameFromItsPoints) {
   test::SyntheticScene scene(150, 5);
   Map client(1);
+  MutexLock client_lock(client.updateMutex());
   const test::SyntheticView v0 = scene.view(poseAt({0, 0, 0}), 0, true);
   const test::SyntheticView v1 = scene.view(poseAt({0.15, 0, 0}), 8, true);
   KeyFrame* k0 = scene.addKeyFrame(client, v0, 0, true);
@@ -162,7 +165,7 @@ TEST(OmittedDescriptors, EdgeSessionFillsUploadedKeyFrameFromItsPoints) {
   const std::size_t vanished_keypoint = known[5];
   std::map<std::size_t, cv::Mat> point_descriptor;
   {
-    std::lock_guard lock(session.map().updateMutex());
+    MutexLock lock(session.map().updateMutex());
     MapPoint* vanished = session.map().mapPoint(k1->point(vanished_keypoint)->id());
     ASSERT_NE(vanished, nullptr);
     session.map().erasePoint(vanished);
@@ -179,7 +182,7 @@ TEST(OmittedDescriptors, EdgeSessionFillsUploadedKeyFrameFromItsPoints) {
   ASSERT_EQ(decoded.keyframe.features.descriptor_omitted.size(), k1->size());
   session.onKeyFrame(decoded);
 
-  std::lock_guard lock(session.map().updateMutex());
+  MutexLock lock(session.map().updateMutex());
   const KeyFrame* on_edge = session.map().keyFrame(k1->id());
   ASSERT_NE(on_edge, nullptr);
   for (const std::size_t j : known) {

@@ -26,6 +26,7 @@ std::string readBytes(const std::filesystem::path& file) {
 std::filesystem::path storeWithAMap(const std::string& name) {
   const auto dir = freshStoreDir(name);
   test::SmallMap small;
+  MutexLock lock(small.map.updateMutex());
   auto store = openMapStore(dir, MapStoreAccess::kServe);
   MapStoreBatch batch;
   for (const KeyFrame* kf : small.map.keyFrames()) batch.keyframes.push_back(keyFrameRecord(*kf));

@@ -22,7 +22,7 @@ std::vector<std::string> dataLines(const std::filesystem::path& file) {
   return lines;
 }
 
-StoredMap storedSmallMap(const test::SmallMap& small) {
+StoredMap storedSmallMap(const test::SmallMap& small) REQUIRES(small.map.updateMutex()) {
   StoredMap map;
   map.name = "small";
   StoredSession session;
@@ -36,6 +36,7 @@ StoredMap storedSmallMap(const test::SmallMap& small) {
 
 TEST(MapExport, TumPlyAndColmapDescribeTheSameMap) {
   const test::SmallMap small;
+  MutexLock lock(small.map.updateMutex());
   const StoredMap map = storedSmallMap(small);
   const auto dir = test::freshStoreDir("export");
   std::filesystem::create_directories(dir);

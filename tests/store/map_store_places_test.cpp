@@ -33,7 +33,7 @@ Vocabulary vocabularyOf(const SmallMap& small, std::uint64_t seed = 0) {
 void writeWhole(const std::shared_ptr<MapStore>& store, StoreSessionId session, SmallMap& small) {
   MapStoreWriter writer(store, session, small.map, nullptr);
   {
-    std::lock_guard lock(small.map.updateMutex());
+    MutexLock lock(small.map.updateMutex());
     writer.onMapChanged(small.map.takeChanges());
   }
   writer.stop();
@@ -53,14 +53,17 @@ TEST(MapStorePlaces, WrittenWithTheKeyFramesAndAttachedForTheSameVocabularyOnly)
   ASSERT_TRUE(stored);
   const StoredSession& session = stored->sessions.at(0);
   ASSERT_EQ(session.places.size(), 3u);
-  for (const KeyFramePlaceRecord& p : session.places) {
-    const KeyFrame* original = small.map.keyFrame(p.keyframe);
-    ASSERT_NE(original, nullptr);
-    EXPECT_EQ(p.vocabulary, vocabulary.checksum());
-    EXPECT_EQ(p.direct_index_depth, kDepth);
-    EXPECT_FALSE(p.bow.empty());
-    EXPECT_EQ(p.bow, original->place()->bow);
-    EXPECT_EQ(p.features, original->place()->features);
+  {
+    MutexLock lock(small.map.updateMutex());
+    for (const KeyFramePlaceRecord& p : session.places) {
+      const KeyFrame* original = small.map.keyFrame(p.keyframe);
+      ASSERT_NE(original, nullptr);
+      EXPECT_EQ(p.vocabulary, vocabulary.checksum());
+      EXPECT_EQ(p.direct_index_depth, kDepth);
+      EXPECT_FALSE(p.bow.empty());
+      EXPECT_EQ(p.bow, original->place()->bow);
+      EXPECT_EQ(p.features, original->place()->features);
+    }
   }
 
   Map loaded;
@@ -70,11 +73,14 @@ TEST(MapStorePlaces, WrittenWithTheKeyFramesAndAttachedForTheSameVocabularyOnly)
   EXPECT_EQ(attached.attached, 3u);
   EXPECT_TRUE(attached.missing.empty());
   EXPECT_EQ(describeKeyFrames(loaded, vocabulary, kDepth), 0u);  // nothing left to compute
-  const KeyFrame* first = loaded.keyFrame(small.keyframes[0]->id());
-  ASSERT_NE(first, nullptr);
-  ASSERT_NE(first->place(), nullptr);
-  EXPECT_EQ(first->place()->vocabulary, &vocabulary);
-  EXPECT_EQ(first->place()->bow, vocabulary.transform(first->features().descriptors));
+  {
+    MutexLock lock(loaded.updateMutex());
+    const KeyFrame* first = loaded.keyFrame(small.keyframes[0]->id());
+    ASSERT_NE(first, nullptr);
+    ASSERT_NE(first->place(), nullptr);
+    EXPECT_EQ(first->place()->vocabulary, &vocabulary);
+    EXPECT_EQ(first->place()->bow, vocabulary.transform(first->features().descriptors));
+  }
 
   // Another vocabulary (or depth): the stored places are not used, the keyframes are described.
   const Vocabulary other = vocabularyOf(small, 7);
@@ -99,7 +105,7 @@ TEST(MapStorePlaces, KeyFrameDescribedAfterItWasWrittenGetsItsPlaceLater) {
   const StoreSessionId session = store->beginSession("m", small.info());
   MapStoreWriter writer(store, session, small.map, nullptr);
   {
-    std::lock_guard lock(small.map.updateMutex());
+    MutexLock lock(small.map.updateMutex());
     writer.onMapChanged(small.map.takeChanges());
   }
   writer.flush();
@@ -109,7 +115,7 @@ TEST(MapStorePlaces, KeyFrameDescribedAfterItWasWrittenGetsItsPlaceLater) {
   EXPECT_EQ(store->loadMap("m")->sessions.at(0).places.size(), 3u);
   // An erased keyframe takes its place with it.
   {
-    std::lock_guard lock(small.map.updateMutex());
+    MutexLock lock(small.map.updateMutex());
     small.map.eraseKeyFrame(small.keyframes[2]);
     writer.onMapChanged(small.map.takeChanges());
   }

@@ -30,13 +30,15 @@ TEST(MapStore, RoundTripKeepsKeyFramesPointsAndObservations) {
     auto stats = std::make_shared<MapStoreWriteStats>();
     MapStoreWriter writer(store, session, small.map, stats);
     {
-      std::lock_guard lock(small.map.updateMutex());
+      MutexLock lock(small.map.updateMutex());
       writer.onMapChanged(small.map.takeChanges());
     }
     writer.stop();
     EXPECT_EQ(stats->totals().keyframes_written, 3u);
+    MutexLock lock(small.map.updateMutex());
     EXPECT_EQ(stats->totals().points_written, small.map.pointCount());
   }
+  MutexLock small_lock(small.map.updateMutex());  // its writer is gone
   auto store = openMapStore(dir, MapStoreAccess::kRead);
   const auto info = store->mapInfo("kitchen");
   ASSERT_TRUE(info);
@@ -80,6 +82,7 @@ TEST(MapStore, RoundTripKeepsKeyFramesPointsAndObservations) {
   // And into a Map again, as a server would hold it: covisibility rebuilt from the points.
   Map loaded;
   loadStoredSession(session, loaded);
+  MutexLock loaded_lock(loaded.updateMutex());
   EXPECT_EQ(loaded.keyFrameCount(), 3u);
   EXPECT_EQ(loaded.pointCount(), small.map.pointCount());
   const KeyFrame* a = loaded.keyFrame(small.keyframes[0]->id());
@@ -100,7 +103,7 @@ TEST(MapStore, LaterBatchesUpdatePosesAndEraseWhatTheMapErased) {
   const StoreSessionId session = store->beginSession("m", small.info());
   MapStoreWriter writer(store, session, small.map, nullptr);
   const auto take = [&] {
-    std::lock_guard lock(small.map.updateMutex());
+    MutexLock lock(small.map.updateMutex());
     writer.onMapChanged(small.map.takeChanges());
   };
   take();
@@ -109,15 +112,23 @@ TEST(MapStore, LaterBatchesUpdatePosesAndEraseWhatTheMapErased) {
   const SE3d corrected(Eigen::Quaterniond::Identity(), Eigen::Vector3d(1, 2, 3));
   MapPoint* doomed = small.keyframes[0]->goodPoints().front();
   const MapPointId doomed_id = doomed->id();
-  small.map.setKeyFramePose(moved, corrected);
-  small.map.erasePoint(doomed);
-  MapPoint* shifted = small.keyframes[1]->goodPoints().back();
-  const Eigen::Vector3d shifted_to = shifted->position() + Eigen::Vector3d(0.5, 0, 0);
-  small.map.relocatePoint(shifted, shifted_to);
+  MapPoint* shifted = nullptr;
+  Eigen::Vector3d shifted_to;
+  {
+    MutexLock lock(small.map.updateMutex());
+    small.map.setKeyFramePose(moved, corrected);
+    small.map.erasePoint(doomed);
+    shifted = small.keyframes[1]->goodPoints().back();
+    shifted_to = shifted->position() + Eigen::Vector3d(0.5, 0, 0);
+    small.map.relocatePoint(shifted, shifted_to);
+  }
   take();
   writer.flush();
   const StoredSession loaded = onlySession(*store->loadMap("m"));
-  EXPECT_EQ(loaded.points.size(), small.map.pointCount());
+  {
+    MutexLock lock(small.map.updateMutex());
+    EXPECT_EQ(loaded.points.size(), small.map.pointCount());
+  }
   for (const MapPointRecord& p : loaded.points) {
     EXPECT_NE(p.id, doomed_id);
     if (p.id == shifted->id()) {
@@ -146,7 +157,7 @@ TEST(MapStore, ResumedSessionIsWrittenOnInPlace) {
   const StoreSessionId session = store->beginSession("m", small.info());
   {
     MapStoreWriter writer(store, session, small.map, nullptr);
-    std::lock_guard lock(small.map.updateMutex());
+    MutexLock lock(small.map.updateMutex());
     writer.onMapChanged(small.map.takeChanges());
   }  // stopped: written, session ended
   const StoredSession stored = onlySession(*store->loadMap("m"));
@@ -160,7 +171,7 @@ TEST(MapStore, ResumedSessionIsWrittenOnInPlace) {
   for (const KeyFrameRecord& k : stored.keyframes) ids.push_back(k.id);
   writer.assumeStored(ids);
   {
-    std::lock_guard lock(resumed.updateMutex());
+    MutexLock lock(resumed.updateMutex());
     KeyFrame* culled = resumed.keyFrame(stored.keyframes[1].id);
     ASSERT_NE(culled, nullptr);
     resumed.eraseKeyFrame(culled);
@@ -179,6 +190,7 @@ TEST(MapStore, ResumedSessionIsWrittenOnInPlace) {
 TEST(MapStore, NamedMapsLiveSideBySideAndRemoveAlone) {
   const auto dir = freshStoreDir("named");
   SmallMap small;
+  MutexLock lock(small.map.updateMutex());
   auto store = openMapStore(dir, MapStoreAccess::kServe);
   MapStoreBatch batch;
   for (const KeyFrame* kf : small.map.keyFrames()) batch.keyframes.push_back(keyFrameRecord(*kf));

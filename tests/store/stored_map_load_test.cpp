@@ -24,7 +24,7 @@ constexpr const char* kSequence = "datasets/7scenes-redkitchen-1000";
 
 // The load as it was written first: every record through the replication functions.
 void loadOneByOne(const StoredSession& session, Map& map) {
-  std::lock_guard lock(map.updateMutex());
+  MutexLock lock(map.updateMutex());
   map.setChangeRecording(false);
   KeyFrameId newest = kInvalidId;
   for (const KeyFrameRecord& record : session.keyframes) {
@@ -53,7 +53,7 @@ KeyFrameId idOf(const KeyFrame* keyframe) {
   return keyframe != nullptr ? keyframe->id() : kInvalidId;
 }
 
-void expectSameMap(Map& a, Map& b) {
+void expectSameMap(Map& a, Map& b) REQUIRES(a.updateMutex(), b.updateMutex()) {
   ASSERT_EQ(a.keyFrameCount(), b.keyFrameCount());
   ASSERT_EQ(a.pointCount(), b.pointCount());
   EXPECT_TRUE(b.changes().empty());
@@ -111,7 +111,8 @@ void expectSameMap(Map& a, Map& b) {
 // they share at least 15 points, or when the newer one shares fewer than 15 with every keyframe
 // and the most with the older one (its first, by id, of the most); strongest links first, ties by
 // id; a keyframe's parent is the keyframe it shares the most points with, when that one is older.
-void expectCovisibilityOfTheObservations(const StoredSession& session, const Map& map) {
+void expectCovisibilityOfTheObservations(const StoredSession& session, const Map& map)
+    REQUIRES(map.updateMutex()) {
   std::map<std::pair<KeyFrameId, KeyFrameId>, int> shared;
   for (const MapPointRecord& p : session.points) {
     std::set<KeyFrameId> observers;
@@ -177,7 +178,11 @@ TEST(StoredMapLoad, RebuildsTheMapOfARealEdgeRunAsOneRecordAtATime) {
   loadOneByOne(session, one_by_one);
   Map loaded;
   loadStoredSession(session, loaded);
-  expectSameMap(one_by_one, loaded);
+  {
+    MutexLock lock_a(one_by_one.updateMutex());
+    MutexLock lock_b(loaded.updateMutex());
+    expectSameMap(one_by_one, loaded);
+  }
   // (expectSameMap draws an id from each map: a fresh reference for the second comparison.)
   Map one_by_one_again;
   loadOneByOne(session, one_by_one_again);
@@ -187,10 +192,17 @@ TEST(StoredMapLoad, RebuildsTheMapOfARealEdgeRunAsOneRecordAtATime) {
   StoredSession& taken = stored_again->sessions.front();
   Map loaded_taking_features;
   loadStoredSessionTakingFeatures(taken, loaded_taking_features);
-  expectSameMap(one_by_one_again, loaded_taking_features);
+  {
+    MutexLock lock_a(one_by_one_again.updateMutex());
+    MutexLock lock_b(loaded_taking_features.updateMutex());
+    expectSameMap(one_by_one_again, loaded_taking_features);
+  }
   EXPECT_TRUE(taken.keyframes.front().features.keypoints.empty());
   EXPECT_EQ(taken.keyframes.front().id, session.keyframes.front().id);
-  expectCovisibilityOfTheObservations(session, loaded);
+  {
+    MutexLock lock(loaded.updateMutex());
+    expectCovisibilityOfTheObservations(session, loaded);
+  }
   std::filesystem::remove_all(store);
   std::filesystem::remove_all(out);
 }
