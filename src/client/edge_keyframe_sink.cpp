@@ -68,7 +68,7 @@ void EdgeKeyFrameSink::sendUpload(KeyFrame* keyframe, bool resend) {
     sequence_ = upload.sequence;
   }
   {
-    std::lock_guard lock(sent_mutex_);
+    MutexLock lock(sent_mutex_);
     sent_times_.emplace_back(upload.sequence, Clock::now());
     if (sent_times_.size() > 256) sent_times_.pop_front();
   }
@@ -81,7 +81,7 @@ void EdgeKeyFrameSink::attachImage(std::size_t frame_index, cv::Mat image) {
 }
 
 std::uint64_t EdgeKeyFrameSink::uploadsInFlight() const {
-  std::lock_guard lock(sent_mutex_);
+  MutexLock lock(sent_mutex_);
   const std::uint64_t sent = sequence_.load();
   const std::uint64_t answered = answered_.load();
   if (sent <= answered) return 0;
@@ -118,7 +118,7 @@ double EdgeKeyFrameSink::onSliceApplied(std::uint64_t upload_sequence,
   if (processed_frame_index > last_optimized_frame_.load()) {
     last_optimized_frame_ = processed_frame_index;
   }
-  std::lock_guard lock(sent_mutex_);
+  MutexLock lock(sent_mutex_);
   if (upload_sequence > answered_.load()) answered_ = upload_sequence;
   std::erase_if(dropped_unanswered_,
                 [&](std::uint64_t sequence) { return sequence <= answered_.load(); });
@@ -132,7 +132,7 @@ double EdgeKeyFrameSink::onSliceApplied(std::uint64_t upload_sequence,
 
 bool EdgeKeyFrameSink::onUploadDropped(std::uint64_t upload_sequence, KeyFrameId keyframe_id) {
   {
-    std::lock_guard lock(sent_mutex_);
+    MutexLock lock(sent_mutex_);
     if (upload_sequence > answered_.load()) dropped_unanswered_.insert(upload_sequence);
   }
   MutexLock lock(map_.updateMutex());

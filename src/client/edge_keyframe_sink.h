@@ -16,6 +16,8 @@
 #include "geometry/camera.h"
 #include "map/keyframe_sink.h"
 #include "map/map.h"
+#include "util/mutex.h"
+#include "util/thread_annotations.h"
 
 namespace edgeslam {
 
@@ -105,9 +107,10 @@ class EdgeKeyFrameSink : public KeyFrameSink {
   static constexpr std::size_t kForgetUploadedPointsEvery = 4096;
   std::unordered_set<MapPointId> uploaded_points_;
   std::deque<UploadRecord> recent_uploads_;  // guarded by the map's update mutex
-  mutable std::mutex sent_mutex_;
-  std::deque<std::pair<std::uint64_t, Clock::time_point>> sent_times_;
-  std::set<std::uint64_t> dropped_unanswered_;  // dropped sequences above answered_
+  mutable Mutex sent_mutex_;
+  std::deque<std::pair<std::uint64_t, Clock::time_point>> sent_times_ GUARDED_BY(sent_mutex_);
+  std::set<std::uint64_t> dropped_unanswered_
+      GUARDED_BY(sent_mutex_);  // dropped sequences above answered_
   std::atomic<std::uint64_t> keyframes_forgotten_{0};
   std::atomic<std::uint64_t> keyframes_resent_{0};
   std::atomic<std::uint64_t> points_forgotten_{0};

@@ -25,7 +25,7 @@ void SemanticFrameFilter::offerMask(std::size_t frame_index, cv::Mat1b labels) {
   }
   History since;  // the keyframe and the frames after it
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     ++counters_.masks_received;
     for (const auto& entry : history_) {
       if (entry.first >= frame_index) since.push_back(entry);
@@ -57,7 +57,7 @@ void SemanticFrameFilter::offerMask(std::size_t frame_index, cv::Mat1b labels) {
     carried.propagator->propagate(*since[k].second, since[k].first - carried.frame);
     carried.frame = since[k].first;
   }
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   // Only the newest keyframe's mask matters.
   if (carried_ && carried_->keyframe_frame > frame_index) return;
   carried_ = std::move(carried);
@@ -66,7 +66,7 @@ void SemanticFrameFilter::offerMask(std::size_t frame_index, cv::Mat1b labels) {
 void SemanticFrameFilter::takeCarriedMask() {
   std::optional<CarriedMask> carried;
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     carried.swap(carried_);
   }
   // An older keyframe's mask than the one in use brings nothing new.
@@ -74,7 +74,7 @@ void SemanticFrameFilter::takeCarriedMask() {
   propagator_ = std::move(carried->propagator);
   source_frame_ = carried->keyframe_frame;
   last_frame_ = carried->frame;
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   ++counters_.masks_applied;
 }
 
@@ -96,7 +96,7 @@ SemanticFrame SemanticFrameFilter::filter(std::size_t frame_index,
     if (out.culled > 0) out.kept = selectFeatures(*all, keep, camera_);
   }
   out.elapsed_ms = timer.elapsedMs();
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   history_.emplace_back(frame_index, std::move(all));
   while (history_.size() > options_.history_frames) history_.pop_front();
   counters_.frames_with_mask += !out.mask.empty();
@@ -115,12 +115,12 @@ void SemanticFrameFilter::noteDelay(std::size_t frames) {
 }
 
 std::optional<std::size_t> SemanticFrameFilter::typicalMaskDelayFrames() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   return typical_delay_;
 }
 
 SemanticFilterCounters SemanticFrameFilter::counters() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   return counters_;
 }
 

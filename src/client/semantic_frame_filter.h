@@ -17,6 +17,8 @@
 #include "features/frame_features.h"
 #include "geometry/camera.h"
 #include "semantic/mask_propagator.h"
+#include "util/mutex.h"
+#include "util/thread_annotations.h"
 
 namespace edgeslam {
 
@@ -73,7 +75,7 @@ class SemanticFrameFilter {
   using History = std::deque<std::pair<std::size_t, std::shared_ptr<const FrameFeatures>>>;
 
   void takeCarriedMask();
-  void noteDelay(std::size_t frames);  // with mutex_ held; on the delivering thread
+  void noteDelay(std::size_t frames) REQUIRES(mutex_);  // on the delivering thread
 
   PinholeCamera camera_;
   SemanticFilterOptions options_;
@@ -83,12 +85,13 @@ class SemanticFrameFilter {
   std::size_t source_frame_ = 0;  // keyframe of the mask in use
   std::size_t last_frame_ = 0;    // last frame the mask in use was carried to
 
-  mutable std::mutex mutex_;  // guards the fields below
-  History history_;
-  std::optional<CarriedMask> carried_;
-  SemanticFilterCounters counters_;
-  std::deque<std::size_t> recent_delays_;
-  std::optional<std::size_t> typical_delay_;  // their median, kept as they arrive
+  mutable Mutex mutex_;  // guards the fields below
+  History history_ GUARDED_BY(mutex_);
+  std::optional<CarriedMask> carried_ GUARDED_BY(mutex_);
+  SemanticFilterCounters counters_ GUARDED_BY(mutex_);
+  std::deque<std::size_t> recent_delays_ GUARDED_BY(mutex_);
+  std::optional<std::size_t> typical_delay_
+      GUARDED_BY(mutex_);  // their median, kept as they arrive
 };
 
 }  // namespace edgeslam

@@ -44,11 +44,14 @@ LocalMapper::~LocalMapper() {
 
 void LocalMapper::start() {
   if (thread_.joinable()) return;
-  stopping_ = false;
+  {
+    MutexLock lock(queue_mutex_);
+    stopping_ = false;
+  }
   thread_.start(
       "local mapping", [this] { run(); },
       [this](const std::string&) {
-        std::lock_guard lock(queue_mutex_);
+        MutexLock lock(queue_mutex_);
         failed_ = true;
         busy_ = false;
         queue_.clear();
@@ -58,7 +61,7 @@ void LocalMapper::start() {
 
 void LocalMapper::stop() {
   {
-    std::lock_guard lock(queue_mutex_);
+    MutexLock lock(queue_mutex_);
     stopping_ = true;
   }
   abort_ba_ = true;
@@ -68,7 +71,7 @@ void LocalMapper::stop() {
 
 void LocalMapper::insertKeyFrame(KeyFrame* keyframe) {
   {
-    std::lock_guard lock(queue_mutex_);
+    MutexLock lock(queue_mutex_);
     if (failed_) return;
     queue_.push_back(keyframe);
   }
@@ -77,37 +80,37 @@ void LocalMapper::insertKeyFrame(KeyFrame* keyframe) {
 }
 
 bool LocalMapper::acceptsKeyFrames() const {
-  std::lock_guard lock(queue_mutex_);
+  MutexLock lock(queue_mutex_);
   return !failed_ && queue_.size() < options_.max_queue;
 }
 
 void LocalMapper::onMapReset() {
-  std::lock_guard lock(queue_mutex_);
+  MutexLock lock(queue_mutex_);
   queue_.clear();
   // recent_points_ belongs to the mapping thread: it drops them before its next keyframe.
   reset_requested_ = true;
 }
 
 bool LocalMapper::hasPending() const {
-  std::lock_guard lock(queue_mutex_);
+  MutexLock lock(queue_mutex_);
   return !queue_.empty();
 }
 
 LocalMapperStats LocalMapper::stats() const {
-  std::lock_guard lock(stats_mutex_);
+  MutexLock lock(stats_mutex_);
   return stats_;
 }
 
 void LocalMapper::pause() {
-  std::unique_lock lock(queue_mutex_);
+  MutexLock lock(queue_mutex_);
   paused_ = true;
   abort_ba_ = true;
-  idle_cv_.wait(lock, [this] { return !busy_; });
+  lock.wait(idle_cv_, [this]() REQUIRES(queue_mutex_) { return !busy_; });
 }
 
 void LocalMapper::resume() {
   {
-    std::lock_guard lock(queue_mutex_);
+    MutexLock lock(queue_mutex_);
     paused_ = false;
   }
   queue_cv_.notify_all();
@@ -118,15 +121,16 @@ void LocalMapper::waitUntilIdle() {
     processAll();
     return;
   }
-  std::unique_lock lock(queue_mutex_);
-  idle_cv_.wait(lock, [this] { return failed_ || (queue_.empty() && !busy_); });
+  MutexLock lock(queue_mutex_);
+  lock.wait(idle_cv_,
+            [this]() REQUIRES(queue_mutex_) { return failed_ || (queue_.empty() && !busy_); });
 }
 
 void LocalMapper::processAll() {
   while (true) {
     KeyFrame* kf = nullptr;
     {
-      std::lock_guard lock(queue_mutex_);
+      MutexLock lock(queue_mutex_);
       if (queue_.empty()) return;
       kf = queue_.front();
       queue_.pop_front();
@@ -145,10 +149,12 @@ void LocalMapper::run() {
   while (true) {
     KeyFrame* kf = nullptr;
     {
-      std::unique_lock lock(queue_mutex_);
+      MutexLock lock(queue_mutex_);
       busy_ = false;
       idle_cv_.notify_all();
-      queue_cv_.wait(lock, [this] { return stopping_ || (!paused_ && !queue_.empty()); });
+      lock.wait(queue_cv_, [this]() REQUIRES(queue_mutex_) {
+        return stopping_ || (!paused_ && !queue_.empty());
+      });
       if (stopping_) return;
       kf = queue_.front();
       queue_.pop_front();
@@ -170,7 +176,7 @@ void LocalMapper::processKeyFrame(KeyFrame* keyframe) {
   failpoint("local_mapping");
   mapKeyFrame(keyframe);
   {
-    std::lock_guard lock(stats_mutex_);
+    MutexLock lock(stats_mutex_);
     ++stats_.keyframes_processed;
   }
   if (on_mapped_) on_mapped_(keyframe);
@@ -223,7 +229,7 @@ void LocalMapper::mapKeyFrame(KeyFrame* keyframe) {
     }
     if (enough_keyframes && options_.run_local_ba) {
       localBundleAdjustment(map_, keyframe, camera_, &abort_ba_);
-      std::lock_guard lock(stats_mutex_);
+      MutexLock lock(stats_mutex_);
       ++stats_.local_ba_runs;
     }
     if (options_.cull_keyframes) cullKeyFrames(keyframe);
@@ -274,7 +280,7 @@ void LocalMapper::cullRecentPoints(KeyFrame* keyframe) {
       ++it;
     }
   }
-  std::lock_guard lock(stats_mutex_);
+  MutexLock lock(stats_mutex_);
   stats_.points_culled += culled;
 }
 
@@ -328,7 +334,7 @@ void LocalMapper::createNewPoints(KeyFrame* keyframe) {
   }
   spdlog::debug("keyframe {} (frame {}): {} new points from {} pairs with {} neighbours",
                 keyframe->id(), keyframe->frameIndex(), created, proposed, neighbours.size());
-  std::lock_guard lock(stats_mutex_);
+  MutexLock lock(stats_mutex_);
   stats_.points_created += created;
   stats_.triangulation_searches += searches;
   stats_.triangulation_bow_searches += bow_searches;
@@ -417,7 +423,7 @@ bool LocalMapper::cullRevisit(KeyFrame* keyframe) {
         keyframe->frameIndex(), older->frameIndex(), keyframe->weight(older),
         (older->cameraCenter() - keyframe->cameraCenter()).norm());
     map_.eraseKeyFrame(keyframe);
-    std::lock_guard stats_lock(stats_mutex_);
+    MutexLock stats_lock(stats_mutex_);
     ++stats_.keyframes_culled;
     ++stats_.revisit_keyframes_culled;
     return true;
@@ -445,7 +451,7 @@ void LocalMapper::cullKeyFrames(KeyFrame* keyframe) {
   }
   spdlog::debug("keyframe culling at frame {}: {} covisibles checked, best ratio {:.2f}, {} culled",
                 keyframe->frameIndex(), checked, best, culled);
-  std::lock_guard stats_lock(stats_mutex_);
+  MutexLock stats_lock(stats_mutex_);
   stats_.keyframes_culled += culled;
 }
 

@@ -22,6 +22,8 @@
 #include "map/pair_triangulation.h"
 #include "optimize/map_optimization.h"
 #include "place/vocabulary.h"
+#include "util/mutex.h"
+#include "util/thread_annotations.h"
 #include "util/worker_thread.h"
 
 namespace edgeslam {
@@ -153,22 +155,22 @@ class LocalMapper : public KeyFrameSink {
   LocalMapperOptions options_;
   MapParticipant map_participant_;
 
-  mutable std::mutex queue_mutex_;
+  mutable Mutex queue_mutex_;
   std::condition_variable queue_cv_;
   std::condition_variable idle_cv_;
-  std::deque<KeyFrame*> queue_;
-  bool busy_ = false;
-  bool stopping_ = false;
-  bool paused_ = false;
-  bool failed_ = false;
+  std::deque<KeyFrame*> queue_ GUARDED_BY(queue_mutex_);
+  bool busy_ GUARDED_BY(queue_mutex_) = false;
+  bool stopping_ GUARDED_BY(queue_mutex_) = false;
+  bool paused_ GUARDED_BY(queue_mutex_) = false;
+  bool failed_ GUARDED_BY(queue_mutex_) = false;
   WorkerThread thread_;
 
   std::atomic<bool> abort_ba_{false};
   std::atomic<bool> reset_requested_{false};
   std::atomic<std::size_t> last_optimized_frame_{0};
   std::list<MapPoint*> recent_points_;
-  mutable std::mutex stats_mutex_;
-  LocalMapperStats stats_;
+  mutable Mutex stats_mutex_;
+  LocalMapperStats stats_ GUARDED_BY(stats_mutex_);
   std::function<void(KeyFrame*)> on_mapped_;
 };
 

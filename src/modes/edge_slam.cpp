@@ -54,7 +54,7 @@ void EdgeSlam::beforeTracking(std::size_t frame_index, const cv::Mat& image) {
 }
 
 void EdgeSlam::noteClientMapSize(std::size_t keyframes, std::size_t points) {
-  std::lock_guard lock(stats_mutex_);
+  MutexLock lock(stats_mutex_);
   client_map_.keyframes = keyframes;
   client_map_.points = points;
   client_map_.max_keyframes = std::max(client_map_.max_keyframes, keyframes);
@@ -72,7 +72,7 @@ ClientMapSize EdgeSlam::clientMapSize() const {
     keyframes = map_.heldKeyFrameCount();
     points = map_.pointCount();
   }
-  std::lock_guard lock(stats_mutex_);
+  MutexLock lock(stats_mutex_);
   ClientMapSize out = client_map_;
   out.keyframes = keyframes;
   out.points = points;
@@ -83,7 +83,7 @@ ClientMapSize EdgeSlam::clientMapSize() const {
 
 std::size_t EdgeSlam::keyFrameCount() const {
   {
-    std::lock_guard lock(stats_mutex_);
+    MutexLock lock(stats_mutex_);
     if (edge_map_keyframes_ > 0) return edge_map_keyframes_;
   }
   return TrackingSlam::keyFrameCount();
@@ -91,7 +91,7 @@ std::size_t EdgeSlam::keyFrameCount() const {
 
 std::size_t EdgeSlam::mapPointCount() const {
   {
-    std::lock_guard lock(stats_mutex_);
+    MutexLock lock(stats_mutex_);
     if (edge_map_points_ > 0) return edge_map_points_;
   }
   return TrackingSlam::mapPointCount();
@@ -101,7 +101,7 @@ void EdgeSlam::onUploadDropped(std::uint64_t sequence, KeyFrameId keyframe) {
   // May run on the tracking thread inside track() (an upload pushed out of the link's full
   // queue): the tracker hears of it after the frame.
   if (!sink_->onUploadDropped(sequence, keyframe)) return;
-  std::lock_guard lock(stats_mutex_);
+  MutexLock lock(stats_mutex_);
   forgotten_keyframes_.push_back(keyframe);
 }
 
@@ -109,7 +109,7 @@ void EdgeSlam::afterFrame() {
   std::vector<KeyFrameId> forgotten;
   std::vector<KeyFrameId> resend;
   {
-    std::lock_guard lock(stats_mutex_);
+    MutexLock lock(stats_mutex_);
     forgotten.swap(forgotten_keyframes_);
     resend.swap(keyframes_to_resend_);
   }
@@ -118,7 +118,7 @@ void EdgeSlam::afterFrame() {
     std::uint64_t resent = 0;
     for (const KeyFrameId id : resend) resent += sink_->resendKeyFrame(id) ? 1 : 0;
     spdlog::info("edge: {} keyframes the edge lacked after its restart uploaded again", resent);
-    std::lock_guard lock(stats_mutex_);
+    MutexLock lock(stats_mutex_);
     resync_.keyframes_resent += resent;
   }
   {
@@ -180,7 +180,7 @@ void EdgeSlam::onSlice(MapSlice slice) {
   const double latency_s = sink_->onSliceApplied(slice.upload_sequence, applied.frame_index);
   if (slice.full_resync) onFullResync(applied.keyframes_edge_lacks);
   for (const MaskRecord& mask : slice.masks) offerMask(mask);
-  std::lock_guard lock(stats_mutex_);
+  MutexLock lock(stats_mutex_);
   ++slices_applied_;
   loops_ += slice.loops_closed;
   if (slice.map_keyframes > 0 || slice.map_points > 0) {
@@ -219,20 +219,20 @@ void EdgeSlam::onFullResync(const std::vector<KeyFrameId>& edge_lacks) {
       "{} lost (evicted here before the edge stored them), {} still on their way",
       edge_lacks.size(), resend.size(), lost_evicted,
       edge_lacks.size() - resend.size() - lost_evicted);
-  std::lock_guard lock(stats_mutex_);
+  MutexLock lock(stats_mutex_);
   ++resync_.full_resyncs;
   resync_.keyframes_lost_evicted += lost_evicted;
   keyframes_to_resend_.insert(keyframes_to_resend_.end(), resend.begin(), resend.end());
 }
 
 ResyncCounters EdgeSlam::resyncCounters() const {
-  std::lock_guard lock(stats_mutex_);
+  MutexLock lock(stats_mutex_);
   return resync_;
 }
 
 void EdgeSlam::offerMask(const MaskRecord& mask) {
   {
-    std::lock_guard lock(stats_mutex_);
+    MutexLock lock(stats_mutex_);
     ++keyframes_segmented_;
     segmentation_ms_.add(mask.segmentation_ms);
   }
@@ -297,7 +297,7 @@ SlamCounters EdgeSlam::counters() const {
   out.exchange.reconnects = link.reconnects;
   out.exchange.keyframes_uploaded = sink_->uploadsSent();
   out.exchange.uploads_unanswered = sink_->uploadsInFlight();
-  std::lock_guard lock(stats_mutex_);
+  MutexLock lock(stats_mutex_);
   out.exchange.slices_applied = slices_applied_;
   out.map.loops = loops_;
   out.exchange.slice_latency_ms = slice_latency_ms_.summary();

@@ -11,6 +11,8 @@
 #include "modes/adaptation_loop.h"
 #include "modes/edge_link.h"
 #include "modes/slam_system.h"
+#include "util/mutex.h"
+#include "util/thread_annotations.h"
 
 namespace edgeslam {
 
@@ -62,22 +64,23 @@ class EdgeSlam : public TrackingSlam {
   std::unique_ptr<AdaptationLoop> adaptation_;
   std::uint64_t applied_config_version_ = 0;
   std::uint64_t uploads_seen_ = 0;
-  mutable std::mutex stats_mutex_;
-  SampleStats slice_latency_ms_;
-  SampleStats slice_apply_ms_;
-  std::uint64_t slices_applied_ = 0;
-  std::uint64_t loops_ = 0;
-  std::uint64_t keyframes_segmented_ = 0;
-  SampleStats segmentation_ms_;
-  std::uint64_t edge_map_keyframes_ = 0;  // as the last slice said (0 = not said)
-  std::uint64_t edge_map_points_ = 0;
-  ClientMapSize client_map_;
+  mutable Mutex stats_mutex_;  // guards the fields below
+  SampleStats slice_latency_ms_ GUARDED_BY(stats_mutex_);
+  SampleStats slice_apply_ms_ GUARDED_BY(stats_mutex_);
+  std::uint64_t slices_applied_ GUARDED_BY(stats_mutex_) = 0;
+  std::uint64_t loops_ GUARDED_BY(stats_mutex_) = 0;
+  std::uint64_t keyframes_segmented_ GUARDED_BY(stats_mutex_) = 0;
+  SampleStats segmentation_ms_ GUARDED_BY(stats_mutex_);
+  std::uint64_t edge_map_keyframes_ GUARDED_BY(stats_mutex_) =
+      0;  // as the last slice said (0 = not said)
+  std::uint64_t edge_map_points_ GUARDED_BY(stats_mutex_) = 0;
+  ClientMapSize client_map_ GUARDED_BY(stats_mutex_);
   // Keyframes forgotten after their upload was dropped, for the tracker's relocalisation
   // database (told on the tracking thread, between frames).
-  std::vector<KeyFrameId> forgotten_keyframes_;
+  std::vector<KeyFrameId> forgotten_keyframes_ GUARDED_BY(stats_mutex_);
   // Keyframes a full resync found missing on the edge, re-sent on the tracking thread.
-  std::vector<KeyFrameId> keyframes_to_resend_;
-  ResyncCounters resync_;
+  std::vector<KeyFrameId> keyframes_to_resend_ GUARDED_BY(stats_mutex_);
+  ResyncCounters resync_ GUARDED_BY(stats_mutex_);
   // This client's keyframe ids: of the link's origin, above what the edge held when it opened.
   std::uint8_t own_id_origin_ = 0;
   KeyFrameId own_ids_above_ = 0;

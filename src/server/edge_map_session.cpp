@@ -55,7 +55,7 @@ void EdgeMapSession::adoptPreloadedMap() {
   // Before the threads start: nothing else touches the keyframes' places or the loop database.
   Stopwatch timer;
   backend_->adoptLoadedKeyFrames(loaded);
-  std::lock_guard state(state_mutex_);
+  MutexLock state(state_mutex_);
   newest_keyframe_ = newest;
   stats_.keyframes_loaded = loaded.size();
   stats_.load_describe_ms = timer.elapsedMs();
@@ -95,7 +95,7 @@ void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
       // server that stored it before a restart: the map has it. The client waits for an answer.
       lock.unlock();
       {
-        std::lock_guard state(state_mutex_);
+        MutexLock state(state_mutex_);
         ++stats_.uploads_duplicate;
       }
       publishSlice(nullptr, upload.sequence);
@@ -155,7 +155,7 @@ void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
       observer_->onMapChanged(uploaded);
     }
     window_.clientHolds(keyframe->id());
-    std::lock_guard state(state_mutex_);
+    MutexLock state(state_mutex_);
     ++stats_.uploads;
     stats_.descriptors_filled += fill.filled;
     stats_.descriptors_lost += fill.lost.size();
@@ -172,14 +172,14 @@ void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
 }
 
 void EdgeMapSession::publishSlice(KeyFrame* mapped, std::uint64_t answers) {
-  std::lock_guard publishing(publish_mutex_);
+  MutexLock publishing(publish_mutex_);
   MapSlice slice;
   {
     MutexLock lock(map_.updateMutex());
     const std::size_t loops = backend_->loops();
     std::vector<MaskRecord> masks;
     {
-      std::lock_guard state(state_mutex_);
+      MutexLock state(state_mutex_);
       masks.swap(pending_masks_);
     }
     if (mapped == nullptr && answers == 0 && map_.changes().empty() && loops == loops_published_ &&
@@ -212,7 +212,7 @@ void EdgeMapSession::publishSlice(KeyFrame* mapped, std::uint64_t answers) {
     }
     slice.loops_closed = static_cast<std::uint32_t>(loops - loops_published_);
     loops_published_ = loops;
-    std::lock_guard state(state_mutex_);
+    MutexLock state(state_mutex_);
     slice.sequence = ++slice_sequence_;
     // A correction answers no upload.
     // The slice answers the upload of the keyframe it mapped (later uploads may be queued).
@@ -238,7 +238,7 @@ void EdgeMapSession::publishSlice(KeyFrame* mapped, std::uint64_t answers) {
 }
 
 void EdgeMapSession::publishFullResync() {
-  std::lock_guard publishing(publish_mutex_);
+  MutexLock publishing(publish_mutex_);
   MapSlice slice;
   {
     MutexLock lock(map_.updateMutex());
@@ -259,7 +259,7 @@ void EdgeMapSession::publishFullResync() {
     const std::size_t loops = backend_->loops();
     slice.loops_closed = static_cast<std::uint32_t>(loops - loops_published_);
     loops_published_ = loops;
-    std::lock_guard state(state_mutex_);
+    MutexLock state(state_mutex_);
     slice.sequence = ++slice_sequence_;
     // newest_keyframe stays unset: the client must not drop observations in its own keyframes
     // that the edge lacks (it re-sends those keyframes).
@@ -278,7 +278,7 @@ void EdgeMapSession::onSegmented(KeyFrameSegmentationResult result) {
   mask.height = (result.labels.rows + mask_downscale_ - 1) / mask_downscale_;
   mask.segmentation_ms = result.segmentation_ms;
   {
-    std::lock_guard state(state_mutex_);
+    MutexLock state(state_mutex_);
     pending_masks_.push_back(std::move(mask));
   }
   publishSlice(nullptr);
@@ -298,7 +298,7 @@ std::optional<std::string> EdgeMapSession::failure() const {
 
 EdgeMapSessionStats EdgeMapSession::stats() const {
   const MappingBackendCounters backend = backend_->counters();
-  std::lock_guard state(state_mutex_);
+  MutexLock state(state_mutex_);
   EdgeMapSessionStats out = stats_;
   out.keyframes_segmented = backend.keyframes_segmented;
   out.movable_points_erased = backend.movable_points_erased;

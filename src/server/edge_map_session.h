@@ -16,6 +16,8 @@
 #include "map/sensor.h"
 #include "mapping/mapping_backend.h"
 #include "server/client_map_window.h"
+#include "util/mutex.h"
+#include "util/thread_annotations.h"
 
 namespace edgeslam {
 
@@ -113,18 +115,18 @@ class EdgeMapSession {
   MapChangeObserver* observer_ = nullptr;
   int mask_downscale_;
   Publish publish_;
-  ClientMapWindow window_;                 // guarded by the map's update mutex
-  KeyFrameId window_centre_ = kInvalidId;  // the last keyframe mapped
+  ClientMapWindow window_ GUARDED_BY(map_.updateMutex());
+  KeyFrameId window_centre_ GUARDED_BY(map_.updateMutex()) = kInvalidId;  // the last mapped
 
   // Mapping and loop closing publish from their own threads: slices leave in sequence order.
-  std::mutex publish_mutex_;
-  mutable std::mutex state_mutex_;  // guards the fields below (not the map)
-  std::uint64_t slice_sequence_ = 0;
-  std::unordered_map<KeyFrameId, std::uint64_t> upload_of_keyframe_;
-  KeyFrameId newest_keyframe_ = kInvalidId;
-  EdgeMapSessionStats stats_;
-  std::size_t loops_published_ = 0;
-  std::vector<MaskRecord> pending_masks_;
+  Mutex publish_mutex_;
+  std::size_t loops_published_ GUARDED_BY(publish_mutex_) = 0;
+  mutable Mutex state_mutex_;  // guards the fields below (not the map)
+  std::uint64_t slice_sequence_ GUARDED_BY(state_mutex_) = 0;
+  std::unordered_map<KeyFrameId, std::uint64_t> upload_of_keyframe_ GUARDED_BY(state_mutex_);
+  KeyFrameId newest_keyframe_ GUARDED_BY(state_mutex_) = kInvalidId;
+  EdgeMapSessionStats stats_ GUARDED_BY(state_mutex_);
+  std::vector<MaskRecord> pending_masks_ GUARDED_BY(state_mutex_);
 
   // Last: its threads stop (in stop()) before the state above goes.
   std::unique_ptr<MappingBackend> backend_;
