@@ -1,8 +1,9 @@
 #include "map/map.h"
-#include "map/map_participant.h"
 
 #include <algorithm>
 #include <stdexcept>
+
+#include "map/map_participant.h"
 
 namespace edgeslam {
 
@@ -367,7 +368,8 @@ MapParticipant::~MapParticipant() {
 }
 
 void MapParticipant::quiescent(Map& map) {
-  if (&map != &map_) throw std::logic_error("MapParticipant::quiescent: not this participant's map");
+  if (&map != &map_)
+    throw std::logic_error("MapParticipant::quiescent: not this participant's map");
   safe_through_ = map.erasures_;
   map.reclaim();
 }

@@ -24,7 +24,8 @@ namespace {
 // by this side after the sender's newest keyframe" exception cannot arise: every keyframe is the
 // sender's.)
 void createPointRecord(Map& map, const MapPointRecord& record,
-                       std::vector<std::pair<KeyFrame*, std::size_t>>& observers) REQUIRES(map.updateMutex()) {
+                       std::vector<std::pair<KeyFrame*, std::size_t>>& observers)
+    REQUIRES(map.updateMutex()) {
   observers.clear();
   for (const PointObservationRecord& obs : record.observations) {
     KeyFrame* kf = map.keyFrame(obs.keyframe);
