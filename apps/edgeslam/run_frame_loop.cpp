@@ -98,6 +98,9 @@ PlayedFrames playFrames(DatasetReader& reader, const FramePlan& plan, SlamSystem
   PassLog* pass_log = companions.pass_log;
   RouteFollowing* route = companions.route;
   std::size_t next_unpaced = 0;
+  // The last frame shown, for a page that opens after the run (headers only: no pixels copied).
+  cv::Mat last_image;
+  TrackResult last_result;
   for (;;) {
     std::size_t i = 0;
     DatasetFrame frame;
@@ -165,9 +168,14 @@ PlayedFrames playFrames(DatasetReader& reader, const FramePlan& plan, SlamSystem
     if (companions.viewer) {
       publishToViewer(companions, played.frame_log.back(), fps, keyframes, map_points, frame,
                       result, slam);
+      last_image = frame.color.empty() ? frame.gray : frame.color;
+      last_result = result;
     }
   }
   progress.finish();
+  if (companions.viewer && !last_image.empty()) {
+    companions.viewer->publishImage(last_image, last_result, slam.lastSemanticFrame(), true);
+  }
   if (pass_log) pass_log->finish(slam, companions.edge_map_size, wall.elapsedMs() / 1000.0);
   if (live_camera) {
     played.live = true;

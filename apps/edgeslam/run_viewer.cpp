@@ -40,9 +40,9 @@ std::unique_ptr<RunViewer::Attachment> RunViewer::attach(const SlamSystem& slam)
 }
 
 void RunViewer::publishImage(const cv::Mat& image, const TrackResult& tracked,
-                             const SemanticFrame* semantic) {
+                             const SemanticFrame* semantic, bool always) {
   viz::FrameImageSlot& images = *view_.images();
-  if (!images.wanted() || image.empty()) return;
+  if ((!always && !images.wanted()) || image.empty()) return;
   viz::FrameImage frame;
   frame.image = image.clone();
   frame.on_map = tracked.features_on_map;

@@ -39,9 +39,10 @@ class RunViewer {
 
   // After a frame: while a page shows the camera image (at most a few times a second), the frame
   // with its features by state (on the map, new: from the tracking result; culled: the semantic
-  // frame's) and movable mask.
-  void publishImage(const cv::Mat& image, const TrackResult& tracked,
-                    const SemanticFrame* semantic);
+  // frame's) and movable mask. `always`: whether or not a page asks (the run's last frame, for a
+  // page opened while the viewer lingers).
+  void publishImage(const cv::Mat& image, const TrackResult& tracked, const SemanticFrame* semantic,
+                    bool always = false);
 
   // Marks the run finished; with `seconds` > 0 keeps serving until then or until SIGINT.
   void finish(double linger_seconds);

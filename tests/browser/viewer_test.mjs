@@ -97,7 +97,8 @@ function runArgs(port, frames) {
 }
 
 async function mobileView(browser) {
-  const first = await start(runArgs(0, 240), /viewer: (http:\/\/[\d.]+:(\d+)\/)/, 'run');
+  // Long enough to still run when a slow (loaded) browser gets the page; it is stopped below.
+  const first = await start(runArgs(0, 900), /viewer: (http:\/\/[\d.]+:(\d+)\/)/, 'run');
   const [, url, port] = first.match;
   const page = await browser.newPage();
   await page.setViewport({ width: 420, height: 900, deviceScaleFactor: 1 });  // a phone
