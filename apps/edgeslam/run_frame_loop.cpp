@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cstdlib>
 #include <string>
+#include <utility>
 
 #include "io/live_camera.h"
 #include "modes/adaptation_loop.h"
@@ -128,8 +129,7 @@ PlayedFrames playFrames(DatasetReader& reader, const FramePlan& plan, SlamSystem
     }
     if (frame.ground_truth) played.ground_truth.push_back({frame.timestamp, *frame.ground_truth});
     Stopwatch frame_timer;
-    const TrackResult result =
-        slam.process(i, frame.timestamp, frame.gray, frame.depth, frame.color);
+    TrackResult result = slam.process(i, frame.timestamp, frame.gray, frame.depth, frame.color);
     const double processing_ms = frame_timer.elapsedMs();
     if (companions.semantic_eval) {
       companions.semantic_eval->addFrame(i % plan.frames_per_pass, result,
@@ -169,7 +169,7 @@ PlayedFrames playFrames(DatasetReader& reader, const FramePlan& plan, SlamSystem
       publishToViewer(companions, played.frame_log.back(), fps, keyframes, map_points, frame,
                       result, slam);
       last_image = frame.color.empty() ? frame.gray : frame.color;
-      last_result = result;
+      last_result = std::move(result);  // its last use
     }
   }
   progress.finish();
