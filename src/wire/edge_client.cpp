@@ -8,10 +8,10 @@
 #include <atomic>
 #include <condition_variable>
 #include <deque>
-#include <mutex>
 #include <thread>
 
 #include "edgeslam/v1/edgeslam.grpc.pb.h"
+#include "util/mutex.h"
 #include "wire/channel_options.h"
 #include "wire/server_security.h"
 #include "wire/wire_convert.h"
@@ -137,13 +137,14 @@ struct EdgeClient::Impl {
   }
 
   // Opens a new session after the server said it lost `lost_session`; only one thread does it.
-  bool reopenSession(std::uint64_t lost_session, const std::string& reason) {
-    std::lock_guard lock(reopen_mutex);
+  bool reopenSession(std::uint64_t lost_session, const std::string& reason)
+      EXCLUDES(reopen_mutex, mutex) {
+    MutexLock lock(reopen_mutex);
     if (session_id.load() != lost_session) return true;  // another thread already did it
     // Before the new session exists, so that every upload it takes is remembered; those the lost
     // session took are not in the new one's map.
     {
-      std::lock_guard state(mutex);
+      MutexLock state(mutex);
       acknowledged_while_resyncing.clear();
     }
     resync_pending.store(true);
@@ -170,7 +171,7 @@ struct EdgeClient::Impl {
   }
 
   // Outside the client's mutex: the owner may take its own locks (its map's) here.
-  void reportDropped(const DroppedUpload& dropped) {
+  void reportDropped(const DroppedUpload& dropped) EXCLUDES(mutex) {
     if (!options.on_upload_dropped) return;
     try {
       options.on_upload_dropped(dropped.sequence, dropped.keyframe);
@@ -192,19 +193,19 @@ struct EdgeClient::Impl {
   // --- stopping --------------------------------------------------------------------------------
 
   // Sleeps up to `duration`, returning early (true) when the client is closing.
-  bool sleepUnlessStopping(std::chrono::milliseconds duration) {
-    std::unique_lock lock(mutex);
-    return wake.wait_for(lock, duration, [&] { return stopping; });
+  bool sleepUnlessStopping(std::chrono::milliseconds duration) EXCLUDES(mutex) {
+    MutexLock lock(mutex);
+    return lock.waitFor(wake, duration, [&]() REQUIRES(mutex) { return stopping; });
   }
 
-  bool isStopping() {
-    std::lock_guard lock(mutex);
+  bool isStopping() EXCLUDES(mutex) {
+    MutexLock lock(mutex);
     return stopping;
   }
 
-  void close() {
+  void close() EXCLUDES(mutex) {
     {
-      std::lock_guard lock(mutex);
+      MutexLock lock(mutex);
       if (closed) return;
       closed = true;
       stopping = true;
@@ -215,7 +216,7 @@ struct EdgeClient::Impl {
     if (upload_thread.joinable()) upload_thread.join();
     if (slice_thread.joinable()) slice_thread.join();
     {
-      std::lock_guard lock(mutex);
+      MutexLock lock(mutex);
       uploads_dropped += queue.size();
       queue.clear();
     }
@@ -233,11 +234,11 @@ struct EdgeClient::Impl {
 
   // --- uploads ---------------------------------------------------------------------------------
 
-  std::uint64_t enqueue(KeyFrameUpload upload) {
+  std::uint64_t enqueue(KeyFrameUpload upload) EXCLUDES(mutex) {
     std::optional<DroppedUpload> overflowed;
     std::uint64_t sequence = 0;
     {
-      std::lock_guard lock(mutex);
+      MutexLock lock(mutex);
       if (upload.sequence == 0) upload.sequence = last_upload_sequence + 1;
       last_upload_sequence = std::max(last_upload_sequence, upload.sequence);
       sequence = upload.sequence;
@@ -262,14 +263,14 @@ struct EdgeClient::Impl {
     return sequence;
   }
 
-  void uploadLoop() {
+  void uploadLoop() EXCLUDES(mutex) {
     Backoff backoff(options.backoff_initial, options.backoff_max);
     while (true) {
       KeyFrameUpload upload;
       DroppedUpload which;
       {
-        std::unique_lock lock(mutex);
-        wake.wait(lock, [&] { return stopping || !queue.empty(); });
+        MutexLock lock(mutex);
+        lock.wait(wake, [&]() REQUIRES(mutex) { return stopping || !queue.empty(); });
         if (stopping) return;
         upload = std::move(queue.front());
         queue.pop_front();
@@ -308,11 +309,11 @@ struct EdgeClient::Impl {
     kDiscarded,  // the client is closing
   };
 
-  void finishUpload(Outcome outcome, const DroppedUpload& which) {
+  void finishUpload(Outcome outcome, const DroppedUpload& which) EXCLUDES(mutex) {
     // Reported before the upload counts as done, so that flushUploads() returning means the
     // owner has heard of it.
     if (outcome == Outcome::kRejected) reportDropped(which);
-    std::lock_guard lock(mutex);
+    MutexLock lock(mutex);
     in_flight = false;
     if (outcome == Outcome::kSent) {
       ++uploads_sent;
@@ -325,7 +326,7 @@ struct EdgeClient::Impl {
   }
 
   void sendWithRetry(v1::UploadKeyFrameRequest& request, const DroppedUpload& which,
-                     Backoff& backoff) {
+                     Backoff& backoff) EXCLUDES(mutex) {
     while (true) {
       const std::uint64_t session = session_id.load();
       *request.mutable_header() = header();
@@ -337,15 +338,18 @@ struct EdgeClient::Impl {
       // While the channel reconnects the call waits (within its deadline) instead of failing at
       // once and sleeping a backoff: it goes out as soon as the server is back.
       context.set_wait_for_ready(true);
+      bool discard = false;
       {
-        std::lock_guard lock(mutex);
-        if (stopping) return finishUpload(Outcome::kDiscarded, which);
-        upload_context = &context;
+        MutexLock lock(mutex);
+        discard = stopping;
+        if (!discard) upload_context = &context;
       }
+      // finishUpload takes the mutex itself: called under it, a close racing this upload hung.
+      if (discard) return finishUpload(Outcome::kDiscarded, which);
       v1::UploadKeyFrameReply reply;
       const grpc::Status status = stub->UploadKeyFrame(&context, request, &reply);
       {
-        std::lock_guard lock(mutex);
+        MutexLock lock(mutex);
         upload_context = nullptr;
       }
       if (status.ok()) {
@@ -376,14 +380,15 @@ struct EdgeClient::Impl {
     }
   }
 
-  bool flush(std::chrono::milliseconds timeout) {
-    std::unique_lock lock(mutex);
-    return flushed.wait_for(lock, timeout, [&] { return queue.empty() && !in_flight; });
+  bool flush(std::chrono::milliseconds timeout) EXCLUDES(mutex) {
+    MutexLock lock(mutex);
+    return lock.waitFor(flushed, timeout,
+                        [&]() REQUIRES(mutex) { return queue.empty() && !in_flight; });
   }
 
   // --- slices ----------------------------------------------------------------------------------
 
-  void sliceLoop() {
+  void sliceLoop() EXCLUDES(mutex) {
     Backoff backoff(options.backoff_initial, options.backoff_max);
     bool first = true;
     while (!isStopping()) {
@@ -395,7 +400,7 @@ struct EdgeClient::Impl {
       grpc::ClientContext context;
       authorize(context);
       {
-        std::lock_guard lock(mutex);
+        MutexLock lock(mutex);
         if (stopping) return;
         stream_context = &context;
       }
@@ -414,7 +419,7 @@ struct EdgeClient::Impl {
       }
       const grpc::Status status = reader->Finish();
       {
-        std::lock_guard lock(mutex);
+        MutexLock lock(mutex);
         stream_context = nullptr;
       }
       if (isStopping()) return;
@@ -442,7 +447,7 @@ struct EdgeClient::Impl {
     }
   }
 
-  void deliver(const v1::MapSlice& message) {
+  void deliver(const v1::MapSlice& message) EXCLUDES(mutex) {
     if (message.sequence() <= last_applied.load()) return;  // already applied before a reconnect
     MapSlice slice;
     try {
@@ -463,7 +468,7 @@ struct EdgeClient::Impl {
     last_applied.store(sequence);
     if (full_resync) {
       resync_pending.store(false);
-      std::lock_guard lock(mutex);
+      MutexLock lock(mutex);
       acknowledged_while_resyncing.clear();
     }
   }
@@ -481,28 +486,28 @@ struct EdgeClient::Impl {
   std::atomic<std::uint8_t> id_origin{0};
   std::atomic<std::uint64_t> id_floor{0};
   std::atomic<bool> reconnecting{false};
-  std::mutex reopen_mutex;
+  Mutex reopen_mutex;
   std::atomic<std::uint64_t> last_applied{0};
   std::atomic<bool> resync_pending{false};
 
-  mutable std::mutex mutex;  // guards everything below up to the counters
+  mutable Mutex mutex;
   std::condition_variable wake;
   std::condition_variable flushed;
-  bool stopping = false;
-  bool closed = false;
-  std::deque<KeyFrameUpload> queue;
-  bool in_flight = false;
-  KeyFrameId in_flight_keyframe = kInvalidId;
+  bool stopping GUARDED_BY(mutex) = false;
+  bool closed GUARDED_BY(mutex) = false;
+  std::deque<KeyFrameUpload> queue GUARDED_BY(mutex);
+  bool in_flight GUARDED_BY(mutex) = false;
+  KeyFrameId in_flight_keyframe GUARDED_BY(mutex) = kInvalidId;
   // Keyframes the session took while a full resync was pending: perhaps after the resync's
   // snapshot of the edge's map, so not listed there, yet not lost.
-  std::vector<KeyFrameId> acknowledged_while_resyncing;
-  std::uint64_t last_upload_sequence = 0;
-  grpc::ClientContext* upload_context = nullptr;
-  grpc::ClientContext* stream_context = nullptr;
-  std::uint64_t uploads_sent = 0;
-  std::uint64_t uploads_dropped = 0;
-  std::uint64_t uploads_overflowed = 0;
-  std::uint64_t uploads_rejected = 0;
+  std::vector<KeyFrameId> acknowledged_while_resyncing GUARDED_BY(mutex);
+  std::uint64_t last_upload_sequence GUARDED_BY(mutex) = 0;
+  grpc::ClientContext* upload_context GUARDED_BY(mutex) = nullptr;
+  grpc::ClientContext* stream_context GUARDED_BY(mutex) = nullptr;
+  std::uint64_t uploads_sent GUARDED_BY(mutex) = 0;
+  std::uint64_t uploads_dropped GUARDED_BY(mutex) = 0;
+  std::uint64_t uploads_overflowed GUARDED_BY(mutex) = 0;
+  std::uint64_t uploads_rejected GUARDED_BY(mutex) = 0;
 
   std::atomic<std::uint64_t> uplink{0};
   std::atomic<std::uint64_t> downlink{0};
@@ -540,7 +545,7 @@ bool EdgeClient::reconnecting() const {
 }
 
 std::vector<KeyFrameId> EdgeClient::pendingUploadKeyFrames() const {
-  std::lock_guard lock(impl_->mutex);
+  MutexLock lock(impl_->mutex);
   std::vector<KeyFrameId> out = impl_->acknowledged_while_resyncing;
   if (impl_->in_flight) out.push_back(impl_->in_flight_keyframe);
   for (const KeyFrameUpload& upload : impl_->queue) out.push_back(upload.keyframe.id);
@@ -556,7 +561,7 @@ bool EdgeClient::flushUploads(std::chrono::milliseconds timeout) {
 }
 
 std::size_t EdgeClient::pendingUploads() const {
-  std::lock_guard lock(impl_->mutex);
+  MutexLock lock(impl_->mutex);
   return impl_->queue.size() + (impl_->in_flight ? 1 : 0);
 }
 
@@ -646,7 +651,7 @@ EdgeClientCounters EdgeClient::counters() const {
   c.uplink_bytes = impl_->uplink.load();
   c.downlink_bytes = impl_->downlink.load();
   {
-    std::lock_guard lock(impl_->mutex);
+    MutexLock lock(impl_->mutex);
     c.uploads_sent = impl_->uploads_sent;
     c.uploads_dropped = impl_->uploads_dropped;
     c.uploads_overflowed = impl_->uploads_overflowed;
