@@ -4,7 +4,6 @@
 #include <atomic>
 #include <filesystem>
 #include <iostream>
-#include <mutex>
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 
@@ -13,6 +12,7 @@
 #include "place/parallel_for.h"
 #include "place/vocabulary_training.h"
 #include "progress_line.h"
+#include "util/mutex.h"
 #include "util/timing_stats.h"
 #include "vocab_images.h"
 
@@ -48,7 +48,7 @@ std::vector<cv::Mat> extractDescriptors(const std::vector<fs::path>& images, int
   std::vector<cv::Mat> descriptors(images.size());
   std::atomic<std::size_t> done{0};
   std::atomic<std::size_t> count{0};
-  std::mutex progress_mutex;
+  Mutex progress_mutex;
   parallelFor(images.size(), threads, [&](std::size_t i, int worker) {
     const cv::Mat image = cv::imread(images[i].string(), cv::IMREAD_GRAYSCALE);
     if (image.empty()) throw std::runtime_error("cannot read image " + images[i].string());
@@ -56,7 +56,7 @@ std::vector<cv::Mat> extractDescriptors(const std::vector<fs::path>& images, int
     extractors[static_cast<std::size_t>(worker)].extract(image, keypoints, descriptors[i]);
     count += static_cast<std::size_t>(descriptors[i].rows);
     const std::size_t finished = ++done;
-    const std::lock_guard lock(progress_mutex);
+    const MutexLock lock(progress_mutex);
     progress.update(fmt::format("extracting ORB  {}/{} images  {} descriptors", finished,
                                 images.size(), count.load()),
                     finished == images.size());

@@ -108,7 +108,7 @@ void SlamSessionBackend::publish(MapSlice slice) {
 }
 
 void SlamSessionBackend::makeMapping(std::optional<StoredSession> resumed) {
-  std::lock_guard view_lock(view_mutex_);
+  MutexLock view_lock(view_mutex_);
   EdgeMapSessionOptions mapping = options_.mapping;
   mapping.backend.mapper.observe_recent_points = true;
   mapping.backend.segmenter = segmenter_;
@@ -219,7 +219,7 @@ std::optional<OffloadResult> SlamSessionBackend::onFrame(OffloadFrame frame) {
     raw.convertTo(depth, CV_32F, 1.0 / 1000.0);
   }
   if (!offload_) {
-    std::lock_guard view_lock(view_mutex_);
+    MutexLock view_lock(view_mutex_);
     SlamOptions slam_options = defaultSlamOptions(config_.camera, config_.sensor);
     slam_options.orb.num_features = config_.settings.features;
     slam_options.orb.num_levels = config_.settings.pyramid_levels;
@@ -241,14 +241,14 @@ std::optional<OffloadResult> SlamSessionBackend::onFrame(OffloadFrame frame) {
 }
 
 std::optional<std::string> SlamSessionBackend::failure() const {
-  std::lock_guard view_lock(view_mutex_);
+  MutexLock view_lock(view_mutex_);
   if (offload_) return offload_->failure();
   if (mapping_) return mapping_->failure();
   return std::nullopt;
 }
 
 MapSample SlamSessionBackend::mapSample(std::size_t max_points) const {
-  std::lock_guard view_lock(view_mutex_);
+  MutexLock view_lock(view_mutex_);
   if (offload_) return offload_->mapSample(max_points);
   MapSample sample;
   if (!mapping_) return sample;
@@ -263,7 +263,7 @@ MapSample SlamSessionBackend::mapSample(std::size_t max_points) const {
 }
 
 std::size_t SlamSessionBackend::loops() const {
-  std::lock_guard view_lock(view_mutex_);
+  MutexLock view_lock(view_mutex_);
   if (mapping_ && mapping_->loopCloser() != nullptr) return mapping_->loopCloser()->loops();
   return 0;
 }

@@ -3,13 +3,13 @@
 // uploads in, map slices out); in offload mode it runs the whole SLAM on the frames it is sent.
 #include <atomic>
 #include <memory>
-#include <mutex>
 #include <optional>
 
 #include "modes/local_slam.h"
 #include "modes/slam_system.h"
 #include "server/edge_map_session.h"
 #include "store/map_store_writer.h"
+#include "util/mutex.h"
 #include "wire/edge_server.h"
 
 namespace edgeslam {
@@ -53,7 +53,9 @@ class SlamSessionBackend : public EdgeSessionBackend {
                         const std::vector<KeyFrameId>& places_missing);
   void publish(MapSlice slice);
 
-  mutable std::mutex view_mutex_;  // guards making mapping_ and offload_, for the viewer
+  // Held where mapping_ and offload_ are made and where a viewer's thread reads them. Not
+  // GUARDED_BY: the session's own thread, their only writer, reads them without it.
+  mutable Mutex view_mutex_;
   SessionConfig config_;
   SliceSink& sink_;
   SlamSessionOptions options_;

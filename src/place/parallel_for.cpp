@@ -3,9 +3,10 @@
 #include <algorithm>
 #include <atomic>
 #include <exception>
-#include <mutex>
 #include <thread>
 #include <vector>
+
+#include "util/mutex.h"
 
 namespace edgeslam {
 
@@ -19,13 +20,13 @@ void parallelFor(std::size_t count, int threads,
   }
   std::atomic<std::size_t> next{0};
   std::exception_ptr failure;
-  std::mutex failure_mutex;
+  Mutex failure_mutex;
   const auto work = [&](int worker) {
     for (std::size_t i = next.fetch_add(1); i < count; i = next.fetch_add(1)) {
       try {
         body(i, worker);
       } catch (...) {
-        const std::lock_guard lock(failure_mutex);
+        const MutexLock lock(failure_mutex);
         if (!failure) failure = std::current_exception();
         next.store(count);
       }

@@ -5,12 +5,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <mutex>
 #include <random>
 #include <stdexcept>
 
 #include "place/bit_majority.h"
 #include "place/parallel_for.h"
+#include "util/mutex.h"
 
 namespace edgeslam {
 namespace {
@@ -203,15 +203,15 @@ class ProgressReporter {
       : callback_(options.progress), total_(total) {}
   void advance(std::size_t amount) {
     if (!callback_ || amount == 0) return;
-    const std::lock_guard lock(mutex_);
+    const MutexLock lock(mutex_);
     done_ += amount;
     callback_({"clustering", std::min(done_, total_), total_});
   }
 
  private:
   const std::function<void(const VocabularyTrainingProgress&)>& callback_;
-  std::mutex mutex_;
-  std::size_t done_ = 0;
+  Mutex mutex_;
+  std::size_t done_ GUARDED_BY(mutex_) = 0;
   std::size_t total_;
 };
 

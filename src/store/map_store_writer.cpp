@@ -11,7 +11,7 @@ namespace edgeslam {
 
 void MapStoreWriteStats::addBatch(std::size_t keyframes, std::size_t points,
                                   std::size_t points_moved, double copy_ms, double write_ms) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   ++totals_.batches;
   totals_.keyframes_written += keyframes;
   totals_.points_written += points;
@@ -21,27 +21,27 @@ void MapStoreWriteStats::addBatch(std::size_t keyframes, std::size_t points,
 }
 
 void MapStoreWriteStats::addFailure() {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   ++totals_.failures;
 }
 
 void MapStoreWriteStats::attach(MapStoreWriter* writer) {
-  std::lock_guard lock(writers_mutex_);
+  MutexLock lock(writers_mutex_);
   writers_.push_back(writer);
 }
 
 void MapStoreWriteStats::detach(MapStoreWriter* writer) {
-  std::lock_guard lock(writers_mutex_);
+  MutexLock lock(writers_mutex_);
   std::erase(writers_, writer);
 }
 
 void MapStoreWriteStats::flushAll() {
-  std::lock_guard lock(writers_mutex_);
+  MutexLock lock(writers_mutex_);
   for (MapStoreWriter* writer : writers_) writer->flush();
 }
 
 MapStoreWriteStats::Totals MapStoreWriteStats::totals() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   Totals out = totals_;
   out.write_ms = write_ms_.summary();
   out.copy_ms = copy_ms_.summary();
@@ -65,12 +65,12 @@ MapStoreWriter::~MapStoreWriter() {
 }
 
 void MapStoreWriter::assumeStored(const std::vector<KeyFrameId>& keyframes) {
-  std::lock_guard writing(write_mutex_);
+  MutexLock writing(write_mutex_);
   stored_keyframes_.insert(keyframes.begin(), keyframes.end());
 }
 
 void MapStoreWriter::storePlacesOf(const std::vector<KeyFrameId>& keyframes) {
-  std::lock_guard writing(write_mutex_);
+  MutexLock writing(write_mutex_);
   awaiting_place_.insert(keyframes.begin(), keyframes.end());
 }
 
@@ -91,7 +91,7 @@ bool MapStoreWriter::addPlace(const KeyFrame& keyframe, MapStoreBatch& batch) {
 }
 
 void MapStoreWriter::onMapCleared() {
-  std::lock_guard lock(pending_mutex_);
+  MutexLock lock(pending_mutex_);
   cleared_ = true;
   keyframes_.clear();
   points_.clear();
@@ -100,7 +100,7 @@ void MapStoreWriter::onMapCleared() {
 }
 
 void MapStoreWriter::onMapChanged(const MapChanges& changes) {
-  std::lock_guard lock(pending_mutex_);
+  MutexLock lock(pending_mutex_);
   for (const auto* ids :
        {&changes.keyframes_created, &changes.keyframes_updated, &changes.keyframes_erased}) {
     keyframes_.insert(ids->begin(), ids->end());
@@ -119,7 +119,7 @@ void MapStoreWriter::onMapChanged(const MapChanges& changes) {
 }
 
 void MapStoreWriter::onMasks(const std::vector<MaskRecord>& masks) {
-  std::lock_guard lock(pending_mutex_);
+  MutexLock lock(pending_mutex_);
   masks_.insert(masks_.end(), masks.begin(), masks.end());
 }
 
@@ -129,7 +129,7 @@ MapStoreBatch MapStoreWriter::takeBatch() {
   std::unordered_set<MapPointId> points;
   std::unordered_set<MapPointId> points_moved;
   {
-    std::lock_guard lock(pending_mutex_);
+    MutexLock lock(pending_mutex_);
     batch.cleared = cleared_;
     cleared_ = false;
     keyframes.swap(keyframes_);
@@ -189,7 +189,7 @@ MapStoreBatch MapStoreWriter::takeBatch() {
 }
 
 void MapStoreWriter::flush() {
-  std::lock_guard writing(write_mutex_);
+  MutexLock writing(write_mutex_);
   if (stopped_) return;
   Stopwatch copy_timer;
   MapStoreBatch batch = takeBatch();
@@ -213,9 +213,10 @@ void MapStoreWriter::flush() {
 }
 
 void MapStoreWriter::run() {
-  std::unique_lock lock(pending_mutex_);
+  MutexLock lock(pending_mutex_);
   while (!stopping_) {
-    wake_.wait_for(lock, std::chrono::duration<double>(interval_s_), [this] { return stopping_; });
+    lock.waitFor(wake_, std::chrono::duration<double>(interval_s_),
+                 [this]() REQUIRES(pending_mutex_) { return stopping_; });
     if (stopping_) break;
     lock.unlock();
     flush();
@@ -226,14 +227,14 @@ void MapStoreWriter::run() {
 void MapStoreWriter::stop() {
   if (stats_) stats_->detach(this);
   {
-    std::lock_guard lock(pending_mutex_);
+    MutexLock lock(pending_mutex_);
     if (stopping_) return;
     stopping_ = true;
   }
   wake_.notify_all();
   if (thread_.joinable()) thread_.join();
   flush();
-  std::lock_guard writing(write_mutex_);
+  MutexLock writing(write_mutex_);
   stopped_ = true;
   try {
     store_->endSession(session_);

@@ -5,7 +5,6 @@
 // writer's own thread. A killed process loses at most the last interval.
 #include <condition_variable>
 #include <memory>
-#include <mutex>
 #include <thread>
 #include <unordered_map>
 #include <unordered_set>
@@ -14,6 +13,7 @@
 #include "map/map.h"
 #include "map/map_change_observer.h"
 #include "store/map_store.h"
+#include "util/mutex.h"
 #include "util/timing_stats.h"
 
 namespace edgeslam {
@@ -42,12 +42,12 @@ class MapStoreWriteStats {
   Totals totals() const;
 
  private:
-  mutable std::mutex mutex_;
-  std::mutex writers_mutex_;  // guards writers_; held while they flush
-  std::vector<MapStoreWriter*> writers_;
-  Totals totals_;
-  SampleStats write_ms_;
-  SampleStats copy_ms_;
+  mutable Mutex mutex_;
+  Mutex writers_mutex_;  // held while the writers flush
+  std::vector<MapStoreWriter*> writers_ GUARDED_BY(writers_mutex_);
+  Totals totals_ GUARDED_BY(mutex_);
+  SampleStats write_ms_ GUARDED_BY(mutex_);
+  SampleStats copy_ms_ GUARDED_BY(mutex_);
 };
 
 class MapStoreWriter : public MapChangeObserver {
@@ -70,15 +70,15 @@ class MapStoreWriter : public MapChangeObserver {
   void storePlacesOf(const std::vector<KeyFrameId>& keyframes);
 
   // Writes what is pending now (on the caller's thread) and waits for it.
-  void flush();
+  void flush() EXCLUDES(write_mutex_, pending_mutex_);
   // Writes the rest, marks the session ended and stops the thread. Call before the map goes.
-  void stop();
+  void stop() EXCLUDES(write_mutex_, pending_mutex_);
 
  private:
-  void run();
-  MapStoreBatch takeBatch();
+  void run() EXCLUDES(write_mutex_, pending_mutex_);
+  MapStoreBatch takeBatch() REQUIRES(write_mutex_) EXCLUDES(pending_mutex_);
   // The keyframe's place as a record; false while it has none.
-  bool addPlace(const KeyFrame& keyframe, MapStoreBatch& batch);
+  bool addPlace(const KeyFrame& keyframe, MapStoreBatch& batch) REQUIRES(write_mutex_);
 
   std::shared_ptr<MapStore> store_;
   StoreSessionId session_;
@@ -86,21 +86,24 @@ class MapStoreWriter : public MapChangeObserver {
   std::shared_ptr<MapStoreWriteStats> stats_;
   double interval_s_;
 
-  std::mutex pending_mutex_;
+  Mutex pending_mutex_;
   std::condition_variable wake_;
-  bool stopping_ = false;
-  bool cleared_ = false;
-  std::unordered_set<KeyFrameId> keyframes_;     // created, changed or erased since the last batch
-  std::unordered_set<MapPointId> points_;        // written whole
-  std::unordered_set<MapPointId> points_moved_;  // only moved (and not in points_)
-  std::vector<MaskRecord> masks_;
+  bool stopping_ GUARDED_BY(pending_mutex_) = false;
+  bool cleared_ GUARDED_BY(pending_mutex_) = false;
+  // Created, changed or erased since the last batch.
+  std::unordered_set<KeyFrameId> keyframes_ GUARDED_BY(pending_mutex_);
+  std::unordered_set<MapPointId> points_ GUARDED_BY(pending_mutex_);  // written whole
+  // Only moved (and not in points_).
+  std::unordered_set<MapPointId> points_moved_ GUARDED_BY(pending_mutex_);
+  std::vector<MaskRecord> masks_ GUARDED_BY(pending_mutex_);
 
-  std::mutex write_mutex_;                           // one batch at a time
-  std::unordered_set<KeyFrameId> stored_keyframes_;  // guarded by write_mutex_
-  // Stored keyframes not described yet when they were written (guarded by write_mutex_).
-  std::unordered_set<KeyFrameId> awaiting_place_;
-  std::unordered_map<const Vocabulary*, std::uint64_t> vocabulary_checksums_;  // write_mutex_
-  bool stopped_ = false;
+  Mutex write_mutex_;  // one batch at a time
+  std::unordered_set<KeyFrameId> stored_keyframes_ GUARDED_BY(write_mutex_);
+  // Stored keyframes not described yet when they were written.
+  std::unordered_set<KeyFrameId> awaiting_place_ GUARDED_BY(write_mutex_);
+  std::unordered_map<const Vocabulary*, std::uint64_t> vocabulary_checksums_
+      GUARDED_BY(write_mutex_);
+  bool stopped_ GUARDED_BY(write_mutex_) = false;
   std::thread thread_;
 };
 

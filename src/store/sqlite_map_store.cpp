@@ -104,7 +104,8 @@ struct SqliteMapStore::PlaceStatements {
 
 SqliteMapStore::SqliteMapStore(const std::filesystem::path& file, MapStoreAccess access,
                                int lock_fd)
-    : lock_fd_(lock_fd),
+    : file_(file),
+      lock_fd_(lock_fd),
       db_(file, access == MapStoreAccess::kRead, access == MapStoreAccess::kServe) {
   const bool writable = access != MapStoreAccess::kRead;
   if (writable && sqlite3_db_readonly(db_.handle(), "main") == 1) {
@@ -222,7 +223,7 @@ MapSummary SqliteMapStore::summary(std::int64_t map_id, const std::string& name)
 }
 
 std::vector<MapSummary> SqliteMapStore::listMaps() {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   std::vector<std::pair<std::int64_t, std::string>> maps;
   {
     SqliteStatement s(db_, "SELECT id, name FROM maps ORDER BY name");
@@ -234,7 +235,7 @@ std::vector<MapSummary> SqliteMapStore::listMaps() {
 }
 
 std::optional<MapSummary> SqliteMapStore::mapInfo(const std::string& name) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   const auto id = mapId(name);
   if (!id) return std::nullopt;
   return summary(*id, name);
@@ -389,7 +390,7 @@ void SqliteMapStore::loadPlaces(StoredSession& session,
 }
 
 std::optional<StoredMap> SqliteMapStore::loadMap(const std::string& name) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   try {
     const auto id = mapId(name);
     if (!id) return std::nullopt;
@@ -408,7 +409,7 @@ std::optional<StoredMap> SqliteMapStore::loadMap(const std::string& name) {
 }
 
 StoreSessionId SqliteMapStore::beginSession(const std::string& map, const StoredSessionInfo& info) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   SqliteTransaction transaction(db_);
   const double now = nowSeconds();
   std::int64_t map_id = 0;
@@ -435,7 +436,7 @@ StoreSessionId SqliteMapStore::beginSession(const std::string& map, const Stored
 
 void SqliteMapStore::write(StoreSessionId session, const MapStoreBatch& batch) {
   if (batch.empty()) return;
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   Statements& s = *statements_;
   SqliteTransaction transaction(db_);
   if (batch.cleared) {
@@ -502,17 +503,17 @@ void SqliteMapStore::write(StoreSessionId session, const MapStoreBatch& batch) {
 }
 
 void SqliteMapStore::endSession(StoreSessionId session) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   statements_->end_session.bind(1, nowSeconds()).bind(2, session).run();
 }
 
 void SqliteMapStore::resumeSession(StoreSessionId session) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   statements_->end_session.bind(1, 0.0).bind(2, session).run();
 }
 
 bool SqliteMapStore::removeMap(const std::string& name) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   const auto id = mapId(name);
   if (!id) return false;
   SqliteTransaction transaction(db_);

@@ -2,12 +2,13 @@
 // The embedded map store: one SQLite database in WAL mode (a killed process never leaves a store
 // that does not open; each batch is one transaction). Thread-safe: calls are serialised by one
 // mutex, so the writers of several sessions share the store.
+#include <filesystem>
 #include <memory>
-#include <mutex>
 #include <unordered_map>
 
 #include "store/map_store.h"
 #include "store/sqlite_database.h"
+#include "util/mutex.h"
 
 namespace edgeslam {
 
@@ -17,7 +18,7 @@ class SqliteMapStore : public MapStore {
   SqliteMapStore(const std::filesystem::path& file, MapStoreAccess access, int lock_fd);
   ~SqliteMapStore() override;
 
-  std::string location() const override { return db_.file().string(); }
+  std::string location() const override { return file_.string(); }
   std::vector<MapSummary> listMaps() override;
   std::optional<MapSummary> mapInfo(const std::string& name) override;
   std::optional<StoredMap> loadMap(const std::string& name) override;
@@ -34,17 +35,20 @@ class SqliteMapStore : public MapStore {
  private:
   struct Statements;
   struct PlaceStatements;
-  std::optional<std::int64_t> mapId(const std::string& name);
-  MapSummary summary(std::int64_t map_id, const std::string& name);
-  StoredSession loadSession(SqliteStatement& row);
+  std::optional<std::int64_t> mapId(const std::string& name) REQUIRES(mutex_);
+  MapSummary summary(std::int64_t map_id, const std::string& name) REQUIRES(mutex_);
+  StoredSession loadSession(SqliteStatement& row) REQUIRES(mutex_);
   void loadPlaces(StoredSession& session,
-                  const std::unordered_map<KeyFrameId, std::size_t>& keyframe_index);
+                  const std::unordered_map<KeyFrameId, std::size_t>& keyframe_index)
+      REQUIRES(mutex_);
 
-  std::mutex mutex_;
+  Mutex mutex_;
+  const std::filesystem::path file_;
   int lock_fd_;
-  SqliteDatabase db_;
-  std::unique_ptr<Statements> statements_;
-  std::unique_ptr<PlaceStatements> place_statements_;  // nullptr in a version 1 store (read)
+  SqliteDatabase db_ GUARDED_BY(mutex_);
+  std::unique_ptr<Statements> statements_ GUARDED_BY(mutex_);
+  // nullptr in a version 1 store (read).
+  std::unique_ptr<PlaceStatements> place_statements_ GUARDED_BY(mutex_);
 };
 
 }  // namespace edgeslam

@@ -45,7 +45,7 @@ bool hasRoutesTable(SqliteDatabase& db) {
 }  // namespace
 
 void SqliteMapStore::saveRoute(const std::string& map, const RouteRecord& route) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   const auto id = mapId(map);
   if (!id) throw StoreError(location() + ": no map named '" + map + "'");
   SqliteTransaction transaction(db_);
@@ -67,7 +67,7 @@ void SqliteMapStore::saveRoute(const std::string& map, const RouteRecord& route)
 }
 
 std::vector<RouteRecord> SqliteMapStore::listRoutes(const std::string& map) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   std::vector<RouteRecord> out;
   const auto id = mapId(map);
   // A store of an older schema, opened to read only, has no routes yet.
@@ -90,7 +90,7 @@ std::vector<RouteRecord> SqliteMapStore::listRoutes(const std::string& map) {
 }
 
 bool SqliteMapStore::removeRoute(const std::string& map, const std::string& route) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   const auto id = mapId(map);
   if (!id || !hasRoutesTable(db_)) return false;
   SqliteTransaction transaction(db_);

@@ -5,9 +5,10 @@
 #include <atomic>
 #include <cstdlib>
 #include <map>
-#include <mutex>
 #include <stdexcept>
 #include <string>
+
+#include "util/mutex.h"
 
 namespace edgeslam {
 namespace {
@@ -37,7 +38,7 @@ class Failpoints {
 
   void hit(std::string_view name) {
     if (!any_.load(std::memory_order_relaxed)) return;
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     const auto found = armed_.find(std::string(name));
     if (found == armed_.end()) return;
     if (++found->second.calls != found->second.at_call) return;
@@ -47,8 +48,8 @@ class Failpoints {
 
  private:
   std::atomic<bool> any_{false};
-  std::mutex mutex_;
-  std::map<std::string, Armed> armed_;
+  Mutex mutex_;
+  std::map<std::string, Armed> armed_ GUARDED_BY(mutex_);
 };
 
 }  // namespace

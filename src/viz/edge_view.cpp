@@ -28,17 +28,17 @@ EdgeView::EdgeView(std::shared_ptr<SessionDirectory> directory, EdgeViewOptions 
     : directory_(std::move(directory)), options_(options) {}
 
 void EdgeView::setStatsSource(StatsSource source) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   stats_ = std::move(source);
 }
 
 void EdgeView::clearStatsSource() {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   stats_ = nullptr;
 }
 
 std::string EdgeView::snapshotJson() {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   const auto now = std::chrono::steady_clock::now();
   if (!built_at_ || now - *built_at_ >= options_.refresh) {
     encoded_ = buildJson();

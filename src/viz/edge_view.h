@@ -10,11 +10,11 @@
 #include <functional>
 #include <map>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "util/mutex.h"
 #include "viz/view_source.h"
 #include "viz/viewed_session_factory.h"
 #include "wire/edge_server.h"
@@ -39,18 +39,18 @@ class EdgeView : public ViewSource {
   std::string snapshotJson() override;
 
  private:
-  std::string buildJson();  // holds mutex_
+  std::string buildJson() REQUIRES(mutex_);
 
   std::shared_ptr<SessionDirectory> directory_;
   EdgeViewOptions options_;
-  std::mutex mutex_;
-  StatsSource stats_;
-  std::uint64_t version_ = 0;
-  std::map<std::uint64_t, std::size_t> loops_seen_;  // by session
-  std::size_t loops_total_ = 0;
-  std::optional<std::chrono::steady_clock::time_point> built_at_;
-  std::string encoded_;
-  std::string last_body_;
+  Mutex mutex_;
+  StatsSource stats_ GUARDED_BY(mutex_);
+  std::uint64_t version_ GUARDED_BY(mutex_) = 0;
+  std::map<std::uint64_t, std::size_t> loops_seen_ GUARDED_BY(mutex_);  // by session
+  std::size_t loops_total_ GUARDED_BY(mutex_) = 0;
+  std::optional<std::chrono::steady_clock::time_point> built_at_ GUARDED_BY(mutex_);
+  std::string encoded_ GUARDED_BY(mutex_);
+  std::string last_body_ GUARDED_BY(mutex_);
 };
 
 }  // namespace edgeslam::viz

@@ -25,14 +25,14 @@ bool FrameImageSlot::wanted() const {
 
 void FrameImageSlot::publish(FrameImage frame) {
   last_publish_ns_ = nowNs();
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   frame_ = std::move(frame);
   ++frame_version_;
 }
 
 std::optional<std::string> FrameImageSlot::jpeg() {
   last_request_ns_ = nowNs();
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   if (frame_version_ == 0) return std::nullopt;
   if (encoded_version_ != frame_version_) {
     encoded_ = renderFrameJpeg(frame_);

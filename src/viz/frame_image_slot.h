@@ -5,10 +5,10 @@
 #include <atomic>
 #include <chrono>
 #include <cstdint>
-#include <mutex>
 #include <optional>
 #include <string>
 
+#include "util/mutex.h"
 #include "viz/frame_image.h"
 
 namespace edgeslam::viz {
@@ -33,11 +33,11 @@ class FrameImageSlot {
   std::atomic<std::int64_t> last_request_ns_{0};
   std::atomic<std::int64_t> last_publish_ns_{0};
 
-  std::mutex mutex_;
-  FrameImage frame_;
-  std::uint64_t frame_version_ = 0;
-  std::string encoded_;
-  std::uint64_t encoded_version_ = 0;
+  Mutex mutex_;
+  FrameImage frame_ GUARDED_BY(mutex_);
+  std::uint64_t frame_version_ GUARDED_BY(mutex_) = 0;
+  std::string encoded_ GUARDED_BY(mutex_);
+  std::uint64_t encoded_version_ GUARDED_BY(mutex_) = 0;
 };
 
 }  // namespace edgeslam::viz

@@ -12,7 +12,7 @@ LiveView::LiveView(LiveViewOptions options)
 
 void LiveView::publishFrame(const RunStatus& status, const std::optional<SE3d>& camera,
                             const std::optional<SE3d>& ground_truth) {
-  std::lock_guard lock(frame_mutex_);
+  MutexLock lock(frame_mutex_);
   ++version_;
   status_ = status;
   if (camera) {
@@ -25,24 +25,24 @@ void LiveView::publishFrame(const RunStatus& status, const std::optional<SE3d>& 
 }
 
 void LiveView::markFinished() {
-  std::lock_guard lock(frame_mutex_);
+  MutexLock lock(frame_mutex_);
   ++version_;
   status_.finished = true;
 }
 
 void LiveView::setMapSampler(MapSampler sampler) {
-  std::lock_guard lock(map_mutex_);
+  MutexLock lock(map_mutex_);
   sampler_ = std::move(sampler);
   map_taken_at_.reset();
 }
 
 void LiveView::clearMapSampler() {
-  std::lock_guard lock(map_mutex_);
+  MutexLock lock(map_mutex_);
   sampler_ = nullptr;
 }
 
 std::uint64_t LiveView::version() const {
-  std::lock_guard lock(frame_mutex_);
+  MutexLock lock(frame_mutex_);
   return version_;
 }
 
@@ -69,7 +69,7 @@ void LiveView::refreshMapIfDue() {
 ViewSnapshot LiveView::snapshotLocked() {
   ViewSnapshot out;
   {
-    std::lock_guard lock(frame_mutex_);
+    MutexLock lock(frame_mutex_);
     out.version = version_;
     out.status = status_;
     if (camera_) out.camera = ViewPose{camera_->translation(), camera_->rotation()};
@@ -91,13 +91,13 @@ ViewSnapshot LiveView::snapshotLocked() {
 }
 
 ViewSnapshot LiveView::snapshot() {
-  std::lock_guard lock(map_mutex_);
+  MutexLock lock(map_mutex_);
   refreshMapIfDue();
   return snapshotLocked();
 }
 
 std::string LiveView::snapshotJson() {
-  std::lock_guard lock(map_mutex_);
+  MutexLock lock(map_mutex_);
   refreshMapIfDue();
   const auto key = std::make_pair(version(), map_generation_);
   if (encoded_for_ != key) {

@@ -9,12 +9,12 @@
 #include <cstddef>
 #include <cstdint>
 #include <functional>
-#include <mutex>
 #include <optional>
 #include <string>
 
 #include "geometry/se3.h"
 #include "modes/slam_system.h"
+#include "util/mutex.h"
 #include "viz/frame_image_slot.h"
 #include "viz/trajectory_decimator.h"
 #include "viz/view_snapshot.h"
@@ -54,27 +54,29 @@ class LiveView : public ViewSource {
   FrameImageSlot* images() override { return &images_; }
 
  private:
-  void refreshMapIfDue();         // holds map_mutex_
-  ViewSnapshot snapshotLocked();  // holds map_mutex_, the map already refreshed
+  void refreshMapIfDue() REQUIRES(map_mutex_);
+  ViewSnapshot snapshotLocked() REQUIRES(map_mutex_);  // the map already refreshed
 
   LiveViewOptions options_;
   FrameImageSlot images_;
 
-  mutable std::mutex frame_mutex_;  // what the run loop publishes
-  std::uint64_t version_ = 0;
-  RunStatus status_;
-  std::optional<SE3d> camera_;
-  TrajectoryDecimator trajectory_;
-  TrajectoryDecimator ground_truth_;
-  std::optional<SE3d> ground_truth_anchor_;  // trajectory frame from ground-truth frame
+  mutable Mutex frame_mutex_;  // what the run loop publishes
+  std::uint64_t version_ GUARDED_BY(frame_mutex_) = 0;
+  RunStatus status_ GUARDED_BY(frame_mutex_);
+  std::optional<SE3d> camera_ GUARDED_BY(frame_mutex_);
+  TrajectoryDecimator trajectory_ GUARDED_BY(frame_mutex_);
+  TrajectoryDecimator ground_truth_ GUARDED_BY(frame_mutex_);
+  // Trajectory frame from ground-truth frame.
+  std::optional<SE3d> ground_truth_anchor_ GUARDED_BY(frame_mutex_);
 
-  std::mutex map_mutex_;  // the readers' side: sampler, map sample and the encoded snapshot
-  MapSampler sampler_;
-  MapSample map_;
-  std::uint64_t map_generation_ = 0;
-  std::optional<std::chrono::steady_clock::time_point> map_taken_at_;
-  std::string encoded_;
-  std::optional<std::pair<std::uint64_t, std::uint64_t>> encoded_for_;  // version, generation
+  Mutex map_mutex_;  // the readers' side: sampler, map sample and the encoded snapshot
+  MapSampler sampler_ GUARDED_BY(map_mutex_);
+  MapSample map_ GUARDED_BY(map_mutex_);
+  std::uint64_t map_generation_ GUARDED_BY(map_mutex_) = 0;
+  std::optional<std::chrono::steady_clock::time_point> map_taken_at_ GUARDED_BY(map_mutex_);
+  std::string encoded_ GUARDED_BY(map_mutex_);
+  // Version, generation.
+  std::optional<std::pair<std::uint64_t, std::uint64_t>> encoded_for_ GUARDED_BY(map_mutex_);
 };
 
 }  // namespace edgeslam::viz

@@ -37,7 +37,7 @@ class ViewedSession : public EdgeSessionBackend {
 void SessionDirectory::opened(Entry entry) {
   addEvent(fmt::format("session {} '{}' ({}) joined", entry.session_id, entry.client_name,
                        entry.sensor));
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   ++opened_;
   sessions_.push_back(std::move(entry));
 }
@@ -45,7 +45,7 @@ void SessionDirectory::opened(Entry entry) {
 void SessionDirectory::closed(std::uint64_t session_id) {
   std::string name;
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     const auto it = std::find_if(sessions_.begin(), sessions_.end(),
                                  [&](const Entry& e) { return e.session_id == session_id; });
     if (it == sessions_.end()) return;
@@ -56,23 +56,23 @@ void SessionDirectory::closed(std::uint64_t session_id) {
 }
 
 void SessionDirectory::addEvent(std::string text) {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   events_.push_back({std::chrono::system_clock::now(), std::move(text)});
   if (events_.size() > kMaxEvents) events_.pop_front();
 }
 
 std::vector<SessionDirectory::Entry> SessionDirectory::sessions() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   return sessions_;
 }
 
 std::vector<ViewerEvent> SessionDirectory::events() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   return {events_.begin(), events_.end()};
 }
 
 std::size_t SessionDirectory::openedCount() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   return opened_;
 }
 

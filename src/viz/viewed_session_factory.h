@@ -7,11 +7,11 @@
 #include <cstdint>
 #include <deque>
 #include <memory>
-#include <mutex>
 #include <string>
 #include <vector>
 
 #include "modes/slam_session_backend.h"
+#include "util/mutex.h"
 #include "wire/edge_server.h"
 
 namespace edgeslam::viz {
@@ -43,10 +43,10 @@ class SessionDirectory {
   static constexpr std::size_t kMaxEvents = 100;
 
  private:
-  mutable std::mutex mutex_;
-  std::vector<Entry> sessions_;
-  std::deque<ViewerEvent> events_;
-  std::size_t opened_ = 0;
+  mutable Mutex mutex_;
+  std::vector<Entry> sessions_ GUARDED_BY(mutex_);
+  std::deque<ViewerEvent> events_ GUARDED_BY(mutex_);
+  std::size_t opened_ GUARDED_BY(mutex_) = 0;
 };
 
 class ViewedSessionFactory : public EdgeSessionFactory {

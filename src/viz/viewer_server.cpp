@@ -73,7 +73,7 @@ std::string ViewerServer::url() const {
 
 void ViewerServer::stop() {
   {
-    std::lock_guard lock(stop_mutex_);
+    MutexLock lock(stop_mutex_);
     stopping_ = true;
   }
   stop_signal_.notify_all();
@@ -83,8 +83,8 @@ void ViewerServer::stop() {
 
 bool ViewerServer::waitForNextEvent() {
   const auto period = std::chrono::duration<double>(1.0 / options_.events_hz);
-  std::unique_lock lock(stop_mutex_);
-  stop_signal_.wait_for(lock, period, [this] { return stopping_.load(); });
+  MutexLock lock(stop_mutex_);
+  lock.waitFor(stop_signal_, period, [this] { return stopping_.load(); });
   return !stopping_;
 }
 

@@ -11,11 +11,11 @@
 #include <atomic>
 #include <condition_variable>
 #include <memory>
-#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <thread>
 
+#include "util/mutex.h"
 #include "viz/view_source.h"
 
 namespace httplib {
@@ -62,7 +62,7 @@ class ViewerServer {
   std::unique_ptr<httplib::Server> server_;
   int port_ = 0;
   std::thread thread_;
-  std::mutex stop_mutex_;
+  Mutex stop_mutex_;  // for stop_signal_ (stopping_ is atomic: the event streams poll it)
   std::condition_variable stop_signal_;
   std::atomic<bool> stopping_{false};
   std::atomic<bool> listening_ended_{false};

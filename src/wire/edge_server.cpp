@@ -4,10 +4,10 @@
 #include <spdlog/spdlog.h>
 
 #include <condition_variable>
-#include <mutex>
 #include <stdexcept>
 #include <thread>
 
+#include "util/mutex.h"
 #include "wire/channel_options.h"
 #include "wire/edge_service.h"
 
@@ -53,14 +53,14 @@ struct EdgeServer::Impl {
                                  : std::string("no client tokens"));
   }
 
-  void reapIdleSessions() {
+  void reapIdleSessions() EXCLUDES(reaper_mutex) {
     const auto period = std::min<std::chrono::milliseconds>(
         std::chrono::milliseconds(500),
         std::max<std::chrono::milliseconds>(limits.idle_timeout / 4,
                                             std::chrono::milliseconds(10)));
-    std::unique_lock lock(reaper_mutex);
+    MutexLock lock(reaper_mutex);
     while (!stopping) {
-      reaper_wake.wait_for(lock, period, [&] { return stopping; });
+      lock.waitFor(reaper_wake, period, [&]() REQUIRES(reaper_mutex) { return stopping; });
       if (stopping) break;
       lock.unlock();
       const std::size_t closed = registry.closeIdle(limits.idle_timeout);
@@ -71,9 +71,9 @@ struct EdgeServer::Impl {
     }
   }
 
-  void shutdown() {
+  void shutdown() EXCLUDES(reaper_mutex) {
     {
-      std::lock_guard lock(reaper_mutex);
+      MutexLock lock(reaper_mutex);
       if (stopping) return;
       stopping = true;
     }
@@ -93,9 +93,9 @@ struct EdgeServer::Impl {
   int bound_port = 0;
   std::string host;
   std::thread reaper;
-  std::mutex reaper_mutex;
+  Mutex reaper_mutex;
   std::condition_variable reaper_wake;
-  bool stopping = false;
+  bool stopping GUARDED_BY(reaper_mutex) = false;
 };
 
 EdgeServer::EdgeServer(const std::string& listen_address,

@@ -171,7 +171,7 @@ grpc::Status EdgeService::OpenSession(grpc::ServerContext* context,
   reply->set_protocol_version(kWireProtocolVersion);
   reply->set_max_message_bytes(limits_.max_message_bytes);
   {
-    std::lock_guard lock(session->backend_mutex);
+    MutexLock lock(session->backend_mutex);
     reply->set_id_floor(session->backend->idFloor());
   }
   session->uplink_bytes += request->ByteSizeLong();
@@ -217,7 +217,7 @@ grpc::Status EdgeService::UploadKeyFrame(grpc::ServerContext* context,
   const std::uint64_t sequence = upload.sequence;
   session->slices.acknowledge(upload.acknowledged_slice);
   reply->set_sequence(sequence);
-  std::lock_guard lock(session->backend_mutex);
+  MutexLock lock(session->backend_mutex);
   if (sequence <= session->last_upload_sequence) {
     ++session->duplicate_uploads;
     reply->set_duplicate(true);
@@ -262,7 +262,7 @@ grpc::Status EdgeService::StreamSlices(grpc::ServerContext* context,
   bool resyncing = request->want_full_resync();
   if (resyncing) {
     next = session->slices.firstAvailable();
-    std::lock_guard lock(session->backend_mutex);
+    MutexLock lock(session->backend_mutex);
     try {
       session->backend->onFullResyncRequested();
     } catch (const std::exception& e) {
@@ -355,7 +355,7 @@ grpc::Status EdgeService::OffloadFrame(grpc::ServerContext* context,
   std::optional<OffloadResult> result;
   const auto start = std::chrono::steady_clock::now();
   {
-    std::lock_guard lock(session->backend_mutex);
+    MutexLock lock(session->backend_mutex);
     if (grpc::Status status = admitUpload(*session); !status.ok()) return status;
     try {
       result = session->backend->onFrame(std::move(frame));

@@ -44,7 +44,7 @@ class EdgeService final : public v1::EdgeSlam::Service {
   // ABORTED, and the session closed, when its back end failed (EdgeSessionBackend::failure()).
   grpc::Status endIfFailed(const ServerSession& session) const;
   // RESOURCE_EXHAUSTED when the session sends uploads or frames faster than its limit.
-  grpc::Status admitUpload(ServerSession& session) const;
+  grpc::Status admitUpload(ServerSession& session) const REQUIRES(session.backend_mutex);
 
   SessionRegistry& registry_;
   std::shared_ptr<EdgeSessionFactory> factory_;

@@ -85,7 +85,7 @@ std::shared_ptr<ServerSession> SessionRegistry::open(SessionConfig config,
                                                      const SessionOwner& owner) {
   std::shared_ptr<ServerSession> reclaimed;
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     const auto owned = owner_sessions_.find(owner.name);
     if (owner.max_sessions > 0 && owned != owner_sessions_.end() &&
         owned->second >= owner.max_sessions) {
@@ -118,20 +118,20 @@ std::shared_ptr<ServerSession> SessionRegistry::open(SessionConfig config,
     session->backend = factory.open(session->config, session->slices);
     if (!session->backend) throw std::runtime_error("the session factory returned no backend");
   } catch (...) {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     origin_in_use_[session->config.id_origin] = false;
     --reserved_;
     releaseOwnerLocked(session->owner);
     throw;
   }
   session->touch();
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   sessions_.emplace(session->config.session_id, session);
   return session;
 }
 
 std::shared_ptr<ServerSession> SessionRegistry::find(std::uint64_t session_id) const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   const auto it = sessions_.find(session_id);
   return it == sessions_.end() ? nullptr : it->second;
 }
@@ -139,7 +139,7 @@ std::shared_ptr<ServerSession> SessionRegistry::find(std::uint64_t session_id) c
 bool SessionRegistry::close(std::uint64_t session_id, CloseReason reason) {
   std::shared_ptr<ServerSession> session;
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     session = removeLocked(session_id);
     if (session == nullptr) return false;
     // Counted before the backend can go, for whoever watches it go.
@@ -155,7 +155,7 @@ std::size_t SessionRegistry::closeIdle(std::chrono::milliseconds idle_timeout) {
   const std::int64_t limit = std::chrono::nanoseconds(idle_timeout).count();
   std::vector<std::uint64_t> idle;
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     for (const auto& [id, session] : sessions_) {
       if (session->active_streams.load() == 0 && now - session->last_activity_ns.load() > limit) {
         idle.push_back(id);
@@ -170,7 +170,7 @@ std::size_t SessionRegistry::closeIdle(std::chrono::milliseconds idle_timeout) {
 void SessionRegistry::closeAll() {
   std::vector<std::uint64_t> ids;
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     for (const auto& entry : sessions_) ids.push_back(entry.first);
   }
   for (const std::uint64_t id : ids) close(id, CloseReason::kShutdown);
@@ -182,7 +182,7 @@ void SessionRegistry::account(const ServerSession& s, CloseReason reason) {
   const std::uint64_t unacknowledged = pushed - std::min(pushed, acknowledged);
   const std::uint64_t dropped = s.slices.droppedUnacknowledged();
   {
-    std::lock_guard lock(totals_mutex_);
+    MutexLock lock(totals_mutex_);
     ClosedSessionTotals& t = closed_totals_;
     ++t.sessions;
     switch (reason) {
@@ -227,14 +227,14 @@ void SessionRegistry::account(const ServerSession& s, CloseReason reason) {
 }
 
 ClosedSessionTotals SessionRegistry::closedTotals() const {
-  std::lock_guard lock(totals_mutex_);
+  MutexLock lock(totals_mutex_);
   return closed_totals_;
 }
 
 std::vector<SessionStats> SessionRegistry::stats() const {
   std::vector<std::shared_ptr<ServerSession>> sessions;
   {
-    std::lock_guard lock(mutex_);
+    MutexLock lock(mutex_);
     for (const auto& entry : sessions_) sessions.push_back(entry.second);
   }
   std::vector<SessionStats> out;
@@ -260,7 +260,7 @@ std::vector<SessionStats> SessionRegistry::stats() const {
 }
 
 std::size_t SessionRegistry::size() const {
-  std::lock_guard lock(mutex_);
+  MutexLock lock(mutex_);
   return sessions_.size();
 }
 

@@ -5,12 +5,12 @@
 #include <cstdint>
 #include <map>
 #include <memory>
-#include <mutex>
 #include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "util/mutex.h"
 #include "wire/edge_server.h"
 #include "wire/slice_queue.h"
 
@@ -39,9 +39,9 @@ struct ServerSession {
   const SessionConfig config;
   std::string owner;  // the client's token label ("" without tokens); set before it is shared
   SliceQueue slices;
-  std::mutex backend_mutex;  // serialises calls into the backend
+  Mutex backend_mutex;  // serialises calls into the backend
   std::unique_ptr<EdgeSessionBackend> backend;
-  std::uint64_t last_upload_sequence = 0;  // guarded by backend_mutex
+  std::uint64_t last_upload_sequence GUARDED_BY(backend_mutex) = 0;
 
   std::atomic<std::int64_t> last_activity_ns{0};
   std::atomic<int> active_streams{0};
@@ -52,7 +52,7 @@ struct ServerSession {
   std::atomic<std::uint64_t> missing_uploads{0};
   std::atomic<std::uint64_t> frames{0};
   std::atomic<std::uint64_t> slices_sent{0};
-  UploadRate upload_rate;  // guarded by backend_mutex
+  UploadRate upload_rate GUARDED_BY(backend_mutex);
 };
 
 class SessionRegistryFull : public std::runtime_error {
@@ -98,27 +98,28 @@ class SessionRegistry {
   bool close(std::uint64_t session_id, CloseReason reason);
   // Adds a closed session to the totals and logs what it leaves undelivered.
   void account(const ServerSession& session, CloseReason reason);
-  std::uint8_t reserveOriginLocked(std::uint8_t preferred);
+  std::uint8_t reserveOriginLocked(std::uint8_t preferred) REQUIRES(mutex_);
   // The session to close for a new one when full, or 0.
-  std::uint64_t reclaimableLocked() const;
+  std::uint64_t reclaimableLocked() const REQUIRES(mutex_);
   // Takes the session out (the caller closes its slices, outside the lock).
-  std::shared_ptr<ServerSession> removeLocked(std::uint64_t session_id);
-  void releaseOwnerLocked(const std::string& owner);
+  std::shared_ptr<ServerSession> removeLocked(std::uint64_t session_id) REQUIRES(mutex_);
+  void releaseOwnerLocked(const std::string& owner) REQUIRES(mutex_);
 
   const std::size_t max_sessions_;
   const SliceQueueLimits slice_limits_;
   const std::chrono::milliseconds reclaim_idle_after_;
-  mutable std::mutex mutex_;
-  std::map<std::uint64_t, std::shared_ptr<ServerSession>> sessions_;
-  std::vector<bool> origin_in_use_ = std::vector<bool>(256, false);
-  std::size_t reserved_ = 0;  // origins taken, including sessions still being opened
-  std::uint8_t next_origin_ = 1;
-  std::mt19937_64 random_{std::random_device{}()};
+  mutable Mutex mutex_;
+  std::map<std::uint64_t, std::shared_ptr<ServerSession>> sessions_ GUARDED_BY(mutex_);
+  std::vector<bool> origin_in_use_ GUARDED_BY(mutex_) = std::vector<bool>(256, false);
+  std::size_t reserved_ GUARDED_BY(mutex_) = 0;  // origins taken, including those being opened
+  std::uint8_t next_origin_ GUARDED_BY(mutex_) = 1;
+  std::mt19937_64 random_ GUARDED_BY(mutex_){std::random_device{}()};
   std::atomic<std::uint64_t> idle_closed_{0};
   std::atomic<std::uint64_t> reclaimed_{0};
-  std::map<std::string, std::size_t> owner_sessions_;  // open or being opened, per owner
-  mutable std::mutex totals_mutex_;
-  ClosedSessionTotals closed_totals_;
+  // Open or being opened, per owner.
+  std::map<std::string, std::size_t> owner_sessions_ GUARDED_BY(mutex_);
+  mutable Mutex totals_mutex_;
+  ClosedSessionTotals closed_totals_ GUARDED_BY(totals_mutex_);
 };
 
 }  // namespace edgeslam
