@@ -6,12 +6,15 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <future>
 #include <stdexcept>
 #include <string>
 #include <thread>
 #include <vector>
+
+#include "util/thread_priority.h"
 
 namespace edgeslam {
 namespace {
@@ -115,6 +118,16 @@ TEST(QueuedWorker, StopEndsAfterTheItemInHandAndLeavesTheRestQueued) {
   worker.processAll();           // the owner may still work off what was left, on its thread
   EXPECT_EQ(record.seen(), (std::vector<int>{1, 2, 3}));
   EXPECT_EQ(record.seenOn().back(), std::this_thread::get_id());
+}
+
+TEST(QueuedWorker, ItsThreadRunsAtTheGivenNiceIncrement) {
+  std::atomic<int> nice{-100};
+  QueuedWorker<int> worker("background", [&](int) { nice = currentThreadNice(); },
+                           {.capacity = 0, .thread_nice = 3, .on_failure = {}});
+  worker.start();
+  worker.push(1);
+  worker.waitUntilIdle();
+  EXPECT_EQ(nice.load(), std::min(19, currentThreadNice() + 3));
 }
 
 TEST(QueuedWorker, AFullQueueDropsItsOldestItemAndCountsIt) {
