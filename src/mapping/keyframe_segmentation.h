@@ -2,19 +2,17 @@
 // Segmentation of keyframes on a worker thread of its own, so that mapping never waits for the
 // network's inference (paper Sec. IV-B: only keyframes are segmented). Jobs queue up to a bound;
 // beyond it the oldest waiting keyframe is skipped (a newer mask serves tracking better).
-#include <condition_variable>
+#include <atomic>
 #include <cstddef>
-#include <deque>
 #include <functional>
 #include <memory>
 #include <opencv2/core.hpp>
-#include <thread>
 
 #include "map/ids.h"
 #include "semantic/segmenter.h"
 #include "util/mutex.h"
+#include "util/queued_worker.h"
 #include "util/timing_stats.h"
-#include "util/worker_thread.h"
 
 namespace edgeslam {
 
@@ -61,26 +59,22 @@ class KeyFrameSegmentationWorker {
   KeyFrameSegmentationCounters counters() const;
   // Why the worker thread ended with an exception (a failed segmentation of one keyframe is
   // counted, not this); nullopt if it did not.
-  std::optional<std::string> failure() const { return thread_.failure(); }
+  std::optional<std::string> failure() const { return queue_.failure(); }
 
  private:
-  void run();
+  // The queue's work: one keyframe segmented, its labels handed to `done`, counted.
+  void segment(KeyFrameSegmentationJob job);
 
   std::shared_ptr<Segmenter> segmenter_;
   Done done_;
-  std::size_t max_queued_;
-  mutable Mutex mutex_;
-  std::condition_variable wake_;
-  std::condition_variable idle_;
-  std::deque<KeyFrameSegmentationJob> queue_ GUARDED_BY(mutex_);
-  bool busy_ GUARDED_BY(mutex_) = false;
-  bool stopping_ GUARDED_BY(mutex_) = false;
-  float pending_nms_ GUARDED_BY(mutex_) = -1.f;
-  std::size_t segmented_ GUARDED_BY(mutex_) = 0;
-  std::size_t skipped_ GUARDED_BY(mutex_) = 0;
-  std::size_t failed_ GUARDED_BY(mutex_) = 0;
-  SampleStats segmentation_ms_ GUARDED_BY(mutex_);
-  WorkerThread thread_;
+  std::atomic<float> pending_nms_{-1.f};
+  mutable Mutex counters_mutex_;
+  std::size_t segmented_ GUARDED_BY(counters_mutex_) = 0;
+  std::size_t failed_ GUARDED_BY(counters_mutex_) = 0;
+  SampleStats segmentation_ms_ GUARDED_BY(counters_mutex_);
+  // Last: its thread, which uses everything above, ends before any of it is destroyed. The jobs
+  // it drops when full are the skipped ones.
+  QueuedWorker<KeyFrameSegmentationJob> queue_;
 };
 
 }  // namespace edgeslam

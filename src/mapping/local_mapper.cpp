@@ -9,7 +9,6 @@
 #include "map/map_matching.h"
 #include "map/pair_triangulation.h"
 #include "util/failpoint.h"
-#include "util/thread_priority.h"
 
 namespace edgeslam {
 
@@ -27,7 +26,9 @@ LocalMapper::LocalMapper(Map& map, const PinholeCamera& camera, LocalMapperOptio
     : map_(map),
       camera_(camera),
       options_(std::move(options)),
-      map_participant_(map, "local mapping") {}
+      map_participant_(map, "local mapping"),
+      queue_("local mapping", [this](KeyFrame* keyframe) { mapNext(keyframe); },
+             {.capacity = 0, .thread_nice = options_.thread_nice, .on_failure = {}}) {}
 
 LocalMapper::~LocalMapper() {
   stop();
@@ -43,56 +44,28 @@ LocalMapper::~LocalMapper() {
 }
 
 void LocalMapper::start() {
-  if (thread_.joinable()) return;
-  {
-    MutexLock lock(queue_mutex_);
-    stopping_ = false;
-  }
-  thread_.start(
-      "local mapping", [this] { run(); },
-      [this](const std::string&) {
-        MutexLock lock(queue_mutex_);
-        failed_ = true;
-        busy_ = false;
-        queue_.clear();
-        idle_cv_.notify_all();
-      });
+  queue_.start();
 }
 
 void LocalMapper::stop() {
-  {
-    MutexLock lock(queue_mutex_);
-    stopping_ = true;
-  }
-  abort_ba_ = true;
-  queue_cv_.notify_all();
-  thread_.join();
+  queue_.stop();
 }
 
 void LocalMapper::insertKeyFrame(KeyFrame* keyframe) {
-  {
-    MutexLock lock(queue_mutex_);
-    if (failed_) return;
-    queue_.push_back(keyframe);
-  }
-  abort_ba_ = true;  // a running local BA gives way to the new keyframe
-  queue_cv_.notify_one();
+  queue_.push(keyframe);  // a running local BA gives way to it
 }
 
 bool LocalMapper::acceptsKeyFrames() const {
-  MutexLock lock(queue_mutex_);
-  return !failed_ && queue_.size() < options_.max_queue;
+  return !queue_.failed() && queue_.size() < options_.max_queue;
 }
 
 void LocalMapper::onMapReset() {
-  MutexLock lock(queue_mutex_);
   queue_.clear();
   // recent_points_ belongs to the mapping thread: it drops them before its next keyframe.
   reset_requested_ = true;
 }
 
 bool LocalMapper::hasPending() const {
-  MutexLock lock(queue_mutex_);
   return !queue_.empty();
 }
 
@@ -102,68 +75,28 @@ LocalMapperStats LocalMapper::stats() const {
 }
 
 void LocalMapper::pause() {
-  MutexLock lock(queue_mutex_);
-  paused_ = true;
-  abort_ba_ = true;
-  lock.wait(idle_cv_, [this]() REQUIRES(queue_mutex_) { return !busy_; });
+  queue_.pause();
 }
 
 void LocalMapper::resume() {
-  {
-    MutexLock lock(queue_mutex_);
-    paused_ = false;
-  }
-  queue_cv_.notify_all();
+  queue_.resume();
 }
 
 void LocalMapper::waitUntilIdle() {
-  if (!thread_.joinable()) {
+  if (!queue_.running()) {
     processAll();
     return;
   }
-  MutexLock lock(queue_mutex_);
-  lock.wait(idle_cv_,
-            [this]() REQUIRES(queue_mutex_) { return failed_ || (queue_.empty() && !busy_); });
+  queue_.waitUntilIdle();
 }
 
 void LocalMapper::processAll() {
-  while (true) {
-    KeyFrame* kf = nullptr;
-    {
-      MutexLock lock(queue_mutex_);
-      if (queue_.empty()) return;
-      kf = queue_.front();
-      queue_.pop_front();
-    }
-    abort_ba_ = false;
-    processKeyFrame(kf);
-    releaseErased();
-  }
+  queue_.processAll();
 }
 
-void LocalMapper::run() {
-  if (!lowerCurrentThreadPriority(options_.thread_nice)) {
-    spdlog::warn("local mapping: could not lower the thread's priority by {}",
-                 options_.thread_nice);
-  }
-  while (true) {
-    KeyFrame* kf = nullptr;
-    {
-      MutexLock lock(queue_mutex_);
-      busy_ = false;
-      idle_cv_.notify_all();
-      lock.wait(queue_cv_, [this]() REQUIRES(queue_mutex_) {
-        return stopping_ || (!paused_ && !queue_.empty());
-      });
-      if (stopping_) return;
-      kf = queue_.front();
-      queue_.pop_front();
-      busy_ = true;
-      abort_ba_ = false;
-    }
-    processKeyFrame(kf);
-    releaseErased();
-  }
+void LocalMapper::mapNext(KeyFrame* keyframe) {
+  processKeyFrame(keyframe);
+  releaseErased();
 }
 
 void LocalMapper::releaseErased() {
@@ -228,7 +161,7 @@ void LocalMapper::mapKeyFrame(KeyFrame* keyframe) {
       enough_keyframes = map_.keyFrameCount() > 2 && !keyframe->isBad();
     }
     if (enough_keyframes && options_.run_local_ba) {
-      localBundleAdjustment(map_, keyframe, camera_, &abort_ba_);
+      localBundleAdjustment(map_, keyframe, camera_, queue_.giveWay());
       MutexLock lock(stats_mutex_);
       ++stats_.local_ba_runs;
     }

@@ -4,16 +4,12 @@
 // local bundle adjustment and removes redundant keyframes. Every map change goes through Map under
 // its mutex.
 #include <atomic>
-#include <condition_variable>
 #include <cstddef>
-#include <deque>
 #include <functional>
 #include <list>
 #include <memory>
-#include <mutex>
 #include <optional>
 #include <string_view>
-#include <thread>
 
 #include "geometry/camera.h"
 #include "map/keyframe_sink.h"
@@ -23,8 +19,8 @@
 #include "optimize/map_optimization.h"
 #include "place/vocabulary.h"
 #include "util/mutex.h"
+#include "util/queued_worker.h"
 #include "util/thread_annotations.h"
-#include "util/worker_thread.h"
 
 namespace edgeslam {
 
@@ -120,7 +116,7 @@ class LocalMapper : public KeyFrameSink {
   void onMapReset() override;
 
   LocalMapperStats stats() const;
-  std::optional<std::string> failure() const { return thread_.failure(); }
+  std::optional<std::string> failure() const { return queue_.failure(); }
 
   // Loop closing: stops mapping between keyframes (a running local BA is aborted) until resume().
   // Returns once the mapping thread is idle; without a thread there is nothing to wait for.
@@ -133,7 +129,8 @@ class LocalMapper : public KeyFrameSink {
   }
 
  private:
-  void run();
+  // The queue's work: one keyframe, then erased points released.
+  void mapNext(KeyFrame* keyframe);
   void processKeyFrame(KeyFrame* keyframe);
   void mapKeyFrame(KeyFrame* keyframe);
   void linkKeyFrame(KeyFrame* keyframe) REQUIRES(map_.updateMutex());
@@ -155,23 +152,15 @@ class LocalMapper : public KeyFrameSink {
   LocalMapperOptions options_;
   MapParticipant map_participant_;
 
-  mutable Mutex queue_mutex_;
-  std::condition_variable queue_cv_;
-  std::condition_variable idle_cv_;
-  std::deque<KeyFrame*> queue_ GUARDED_BY(queue_mutex_);
-  bool busy_ GUARDED_BY(queue_mutex_) = false;
-  bool stopping_ GUARDED_BY(queue_mutex_) = false;
-  bool paused_ GUARDED_BY(queue_mutex_) = false;
-  bool failed_ GUARDED_BY(queue_mutex_) = false;
-  WorkerThread thread_;
-
-  std::atomic<bool> abort_ba_{false};
   std::atomic<bool> reset_requested_{false};
   std::atomic<std::size_t> last_optimized_frame_{0};
   std::list<MapPoint*> recent_points_;
   mutable Mutex stats_mutex_;
   LocalMapperStats stats_ GUARDED_BY(stats_mutex_);
   std::function<void(KeyFrame*)> on_mapped_;
+  // Last: its thread, which uses everything above, ends before any of it is destroyed. Its
+  // giveWay() flag aborts a running local BA (a new keyframe, pause(), stop()).
+  QueuedWorker<KeyFrame*> queue_;
 };
 
 }  // namespace edgeslam

@@ -5,7 +5,6 @@
 #include <exception>
 
 #include "mapping/loop_global_ba.h"
-#include "util/thread_priority.h"
 #include "util/timing_stats.h"
 
 namespace edgeslam {
@@ -26,52 +25,30 @@ LoopCloser::LoopCloser(Map& map, const PinholeCamera& camera,
       options_(std::move(options)),
       map_participant_(map, "loop closing"),
       mapper_(mapper),
-      detector_(std::move(vocabulary), options_.detector) {}
+      detector_(std::move(vocabulary), options_.detector),
+      queue_("loop closing", [this](KeyFrame* keyframe) { closeLoopsAt(keyframe); },
+             {.capacity = 0, .thread_nice = options_.thread_nice, .on_failure = {}}) {}
 
 LoopCloser::~LoopCloser() {
   stop();
 }
 
 void LoopCloser::start() {
-  if (!options_.threaded || thread_.joinable()) return;
-  {
-    MutexLock lock(queue_mutex_);
-    stopping_ = false;
-  }
-  thread_.start(
-      "loop closing", [this] { run(); },
-      [this](const std::string&) {
-        MutexLock lock(queue_mutex_);
-        failed_ = true;
-        busy_ = false;
-        queue_.clear();
-        idle_cv_.notify_all();
-      });
+  if (options_.threaded) queue_.start();
 }
 
 void LoopCloser::stop() {
-  {
-    MutexLock lock(queue_mutex_);
-    stopping_ = true;
-  }
-  queue_cv_.notify_all();
-  thread_.join();
+  queue_.stop();
   stopGlobalBundleAdjustment();
 }
 
 void LoopCloser::insertKeyFrame(KeyFrame* keyframe) {
-  {
-    MutexLock lock(queue_mutex_);
-    if (failed_) return;
-    queue_.push_back(keyframe);
-  }
-  queue_cv_.notify_one();
+  queue_.push(keyframe);
 }
 
 void LoopCloser::onMapReset() {
   reset_requested_ = true;
   cancel_global_ba_ = true;  // no join: the caller may hold the map mutex the run needs
-  MutexLock lock(queue_mutex_);
   queue_.clear();
 }
 
@@ -85,17 +62,7 @@ void LoopCloser::processAll() {
     waitUntilIdle();
     return;
   }
-  while (true) {
-    KeyFrame* keyframe = nullptr;
-    {
-      MutexLock lock(queue_mutex_);
-      if (queue_.empty()) return;
-      keyframe = queue_.front();
-      queue_.pop_front();
-    }
-    processKeyFrame(keyframe);
-    releaseErased();
-  }
+  queue_.processAll();
 }
 
 void LoopCloser::fileKeyFrame(KeyFrame* keyframe) {
@@ -105,43 +72,24 @@ void LoopCloser::fileKeyFrame(KeyFrame* keyframe) {
 }
 
 void LoopCloser::waitUntilIdle() {
-  if (!options_.threaded || !thread_.joinable()) {
-    if (!options_.threaded) processAll();
+  if (options_.threaded) {
+    queue_.waitUntilIdle();  // returns at once when not started
   } else {
-    MutexLock lock(queue_mutex_);
-    lock.wait(idle_cv_,
-              [this]() REQUIRES(queue_mutex_) { return failed_ || (queue_.empty() && !busy_); });
+    processAll();
   }
   MutexLock lock(global_ba_mutex_);
   global_ba_thread_.join();
 }
 
 std::optional<std::string> LoopCloser::failure() const {
-  if (auto cause = thread_.failure()) return cause;
+  if (auto cause = queue_.failure()) return cause;
   MutexLock lock(global_ba_mutex_);
   return global_ba_thread_.failure();
 }
 
-void LoopCloser::run() {
-  if (!lowerCurrentThreadPriority(options_.thread_nice)) {
-    spdlog::warn("loop closing: could not lower the thread's priority by {}", options_.thread_nice);
-  }
-  while (true) {
-    KeyFrame* keyframe = nullptr;
-    {
-      MutexLock lock(queue_mutex_);
-      busy_ = false;
-      idle_cv_.notify_all();
-      lock.wait(queue_cv_,
-                [this]() REQUIRES(queue_mutex_) { return stopping_ || !queue_.empty(); });
-      if (stopping_) return;
-      keyframe = queue_.front();
-      queue_.pop_front();
-      busy_ = true;
-    }
-    processKeyFrame(keyframe);
-    releaseErased();
-  }
+void LoopCloser::closeLoopsAt(KeyFrame* keyframe) {
+  processKeyFrame(keyframe);
+  releaseErased();
 }
 
 void LoopCloser::releaseErased() {

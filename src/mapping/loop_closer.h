@@ -5,13 +5,10 @@
 // adjustment on another thread that tracking and mapping do not wait for; a newer loop abandons it
 // (loop_global_ba.h). Every map change goes through Map under its update mutex.
 #include <atomic>
-#include <condition_variable>
 #include <cstddef>
 #include <cstdint>
-#include <deque>
 #include <functional>
 #include <memory>
-#include <thread>
 #include <vector>
 
 #include "geometry/camera.h"
@@ -24,6 +21,7 @@
 #include "mapping/loop_verifier.h"
 #include "place/vocabulary.h"
 #include "util/mutex.h"
+#include "util/queued_worker.h"
 #include "util/worker_thread.h"
 
 namespace edgeslam {
@@ -109,7 +107,8 @@ class LoopCloser {
   std::optional<std::string> failure() const;
 
  private:
-  void run();
+  // The queue's work: one keyframe, then erased keyframes released.
+  void closeLoopsAt(KeyFrame* keyframe);
   void processKeyFrame(KeyFrame* keyframe);
   void closeLoop(const VerifiedLoop& loop);
   void launchGlobalBundleAdjustment();
@@ -126,14 +125,6 @@ class LoopCloser {
   LoopDetector detector_;
   std::size_t keyframes_since_loop_ = 0;
 
-  mutable Mutex queue_mutex_;
-  std::condition_variable queue_cv_;
-  std::condition_variable idle_cv_;
-  std::deque<KeyFrame*> queue_ GUARDED_BY(queue_mutex_);
-  bool busy_ GUARDED_BY(queue_mutex_) = false;
-  bool stopping_ GUARDED_BY(queue_mutex_) = false;
-  bool failed_ GUARDED_BY(queue_mutex_) = false;
-  WorkerThread thread_;
   std::atomic<bool> reset_requested_{false};
 
   mutable Mutex
@@ -145,6 +136,8 @@ class LoopCloser {
   mutable Mutex stats_mutex_;
   LoopCloserStats stats_ GUARDED_BY(stats_mutex_);
   std::function<void()> on_corrected_;
+  // Last: its thread, which uses everything above, ends before any of it is destroyed.
+  QueuedWorker<KeyFrame*> queue_;
 };
 
 }  // namespace edgeslam

@@ -23,8 +23,10 @@ class WorkerThread {
   WorkerThread& operator=(const WorkerThread&) = delete;
 
   // `name` says what the worker does ("local mapping"): the cause reads "<name> failed: <what>".
-  // A worker that is still joinable is joined first.
-  void start(std::string name, std::function<void()> body, FailureHandler on_failure = {});
+  // `nice` > 0 lowers the thread's priority by that much first (util/thread_priority.h; a refusal
+  // is logged, not fatal). A worker that is still joinable is joined first.
+  void start(std::string name, std::function<void()> body, FailureHandler on_failure = {},
+             int nice = 0);
   void join();
   bool joinable() const { return thread_.joinable(); }
   std::optional<std::string> failure() const;
