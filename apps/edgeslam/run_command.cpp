@@ -15,6 +15,7 @@
 #include "io/repeated_dataset.h"
 #include "linkem/link_settings.h"
 #include "map_store_option.h"
+#include "modes/edge_localization_slam.h"
 #include "modes/edge_slam.h"
 #include "modes/embedded_edge.h"
 #include "modes/grpc_edge_link.h"
@@ -105,8 +106,13 @@ EdgeEndpoint openEdge(const RunOptions& options, const MappingBackendOptions& ba
   session.mapping.backend.vocabulary = backend.vocabulary;
   session.mapping.backend.loop_closing = backend.loop_closing;
   session.mapping.backend.loop_closer = backend.loop_closer;
-  // Offload sessions keep no map yet: only edge mode opens the store.
-  if (options.mode == "edge") edge.store = openStoreForWriting(options.maps);
+  // Offload sessions keep no map yet: only edge mode opens the store. A localise-only session
+  // only reads it.
+  if (options.mode == "edge" && options.localize_only) {
+    edge.store.store = openMapStore(storeDirectory(options.maps), MapStoreAccess::kRead);
+  } else if (options.mode == "edge") {
+    edge.store = openStoreForWriting(options.maps);
+  }
   session.store = edge.store.store;
   session.store_stats = edge.store.stats;
   EmbeddedEdge::FactoryWrapper wrap;
@@ -135,6 +141,7 @@ SessionConfig sessionConfig(const PinholeCamera& camera, Sensor sensor,
   config.settings.scale_factor = slam_options.orb.scale_factor;
   config.settings.semantic = options.semantic;
   config.settings.client_map_keyframes = options.client_map_keyframes;
+  config.settings.localize_only = options.localize_only;
   return config;
 }
 
@@ -184,6 +191,9 @@ std::unique_ptr<SlamSystem> makeSlamSystem(const RunOptions& options, const std:
   // max_in_flight_reconnecting); otherwise the sink's own bound keeps the queue short.
   client_options.upload_queue_capacity = 32;
   auto link = std::make_unique<GrpcEdgeLink>(edge.address, config, client_options);
+  if (options.localize_only) {
+    return std::make_unique<EdgeLocalizationSlam>(camera, slam_options, std::move(link));
+  }
   AdaptationLoopOptions adaptation;
   adaptation.adapt = options.adapt;
   adaptation.controller.initial_row = 0;  // the run starts with Table I row 1
@@ -402,8 +412,10 @@ void addRunOptions(CLI::App* run, const std::shared_ptr<RunOptions>& options) {
                 "thread, so two runs give the same trajectory (for tests and bisecting; slower)")
       ->excludes(realtime);
   run->add_flag("--localize-only", options->localize_only,
-                "Local mode: localise in the stored map --map (from --maps) and follow it; no "
-                "keyframe is made and the store is opened read-only");
+                "Localise in the stored map --map and follow it, changing nothing in it (no "
+                "keyframe is made). Local mode: the map from --maps, opened read-only. Edge mode "
+                "(and client): the edge's stored map; the edge relocalises lost frames against "
+                "all of it and sends the part around the camera");
   run->add_option("--route", options->route,
                   "With --localize-only: follow this route of the map (`edgeslam route make`): an "
                   "instruction every frame (instructions.csv, progress line, viewer) and the "

@@ -141,6 +141,15 @@ void RunReport::addModeMetrics() {
         {"map", options.map_name},
         {"stored_keyframes", slam_.keyFrameCount()},
         {"first_pose_frame", first == log.end() ? nlohmann::json() : nlohmann::json(first->index)}};
+    const EdgeLocalizationCounters& edge = counters_.localization;
+    if (edge.queries > 0) {
+      // Through the edge: the questions the client asked and how they were answered.
+      metrics["localization"]["edge"] = {{"queries", edge.queries},
+                                         {"relocalization_queries", edge.relocalization_queries},
+                                         {"relocalized_by_edge", edge.relocalized_by_edge},
+                                         {"window_moves", edge.window_moves},
+                                         {"answer_ms", toJson(edge.answer_ms)}};
+    }
   }
   if (companions_.route) {
     metrics["navigation"] =

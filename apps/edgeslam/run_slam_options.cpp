@@ -58,10 +58,10 @@ SlamOptions slamOptionsForRun(const RunOptions& options, const PinholeCamera& ca
     cv::setNumThreads(1);
   }
   if (options.localize_only) {
-    if (mode != "local") {
+    if (mode == "offload") {
       throw CLI::ValidationError("--localize-only",
-                                 "applies to --mode local only so far (the edge does not yet "
-                                 "relocalise a client in a stored map)");
+                                 "applies to --mode local and edge (an offloading client tracks "
+                                 "nothing itself)");
     }
     if (options.map_name.empty()) {
       throw CLI::ValidationError("--localize-only",

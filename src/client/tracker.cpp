@@ -75,6 +75,13 @@ void Tracker::localizeInMap() {
   state_ = TrackingState::kLost;
 }
 
+void Tracker::localizeInArrivingMap() {
+  if (!options_.localization_only) {
+    throw std::logic_error("localisation through the edge needs TrackerOptions::localization_only");
+  }
+  state_ = TrackingState::kLost;
+}
+
 void Tracker::onMapWindowChanged(const std::vector<KeyFrameId>& evicted,
                                  const std::vector<KeyFrameId>& entered) {
   MutexLock lock(map_.updateMutex());
@@ -314,22 +321,6 @@ bool Tracker::initializeRgbd(Frame& frame) {
   return true;
 }
 
-int Tracker::discardOutliers(Frame& frame) {
-  int inliers = 0;
-  for (std::size_t i = 0; i < frame.size(); ++i) {
-    if (frame.points[i] == nullptr) continue;
-    if (frame.outliers[i]) {
-      frame.points[i]->track_in_view = false;
-      frame.points[i]->last_frame_seen = frame.index;
-      frame.points[i] = nullptr;
-      frame.outliers[i] = false;
-    } else if (frame.points[i]->observationCount() > 0) {
-      ++inliers;
-    }
-  }
-  return inliers;
-}
-
 bool Tracker::trackWithMotionModel(Frame& frame, std::size_t steps) {
   const Frame& last = *last_frame_;
   SE3d since_last;
@@ -346,7 +337,7 @@ bool Tracker::trackWithMotionModel(Frame& frame, std::size_t steps) {
   }
   if (matches >= 20) {
     optimizeFramePose(frame);
-    const int inliers = discardOutliers(frame);
+    const int inliers = discardFrameOutliers(frame);
     spdlog::debug("frame {}: motion model over {} frames: {} matches, {} inliers", frame.index,
                   steps, matches, inliers);
     if (inliers >= options_.min_inliers_motion) return true;
@@ -376,7 +367,7 @@ bool Tracker::trackReferenceKeyFrame(Frame& frame) {
   if (matches < 15) return false;
   frame.T_cw = last_frame_->T_cw ? *last_frame_->T_cw : reference_keyframe_->pose();
   optimizeFramePose(frame);
-  return discardOutliers(frame) >= options_.min_inliers_motion;
+  return discardFrameOutliers(frame) >= options_.min_inliers_motion;
 }
 
 std::vector<KeyFrame*> Tracker::relocalizationCandidates(const Frame& frame) {
@@ -388,6 +379,14 @@ std::vector<KeyFrame*> Tracker::relocalizationCandidates(const Frame& frame) {
       candidates.push_back(kf);
     }
   };
+  if (relocalization_hint_ != kInvalidId) {
+    // The edge found the frame near this keyframe: it and its neighbours go first.
+    KeyFrame* hint = map_.keyFrame(relocalization_hint_);
+    if (hint != nullptr && !hint->isBad()) {
+      add(hint);
+      for (KeyFrame* kf : hint->bestCovisibles(kRelocalizationHintNeighbours)) add(kf);
+    }
+  }
   if (places_) {
     for (KeyFrameId id : places_->similar(*frame.features, options_.relocalization_candidates)) {
       add(map_.keyFrame(id));
@@ -403,63 +402,15 @@ std::vector<KeyFrame*> Tracker::relocalizationCandidates(const Frame& frame) {
   return candidates;
 }
 
-int Tracker::matchForRelocalization(KeyFrame& candidate, Frame& frame) {
-  std::fill(frame.points.begin(), frame.points.end(), nullptr);
-  std::fill(frame.outliers.begin(), frame.outliers.end(), false);
-  if (!places_) return matchKeyFrameByDescriptor(candidate, frame, 0.75f);
-  int matched = 0;
-  for (const cv::DMatch& m : places_->match(candidate)) {
-    MapPoint* p = candidate.point(static_cast<std::size_t>(m.trainIdx));
-    if (p == nullptr || p->isBad()) continue;
-    frame.points[static_cast<std::size_t>(m.queryIdx)] = p;
-    ++matched;
-  }
-  return matched;
-}
-
 bool Tracker::relocalize(Frame& frame) {
-  const Stopwatch timer;
-  for (KeyFrame* kf : relocalizationCandidates(frame)) {
-    // Candidates come best first; a frame that has spent its budget gives up, and the next
-    // frame tries again.
-    if (timer.elapsedMs() > options_.relocalization_budget_ms) break;
-    if (matchForRelocalization(*kf, frame) < 15) continue;
-    std::vector<Eigen::Vector2d> pixels;
-    std::vector<Eigen::Vector3d> points;
-    std::vector<std::size_t> index;
-    for (std::size_t i = 0; i < frame.size(); ++i) {
-      if (frame.points[i] == nullptr) continue;
-      const cv::Point2f& pt = frame.features->keypoints[i].pt;
-      pixels.emplace_back(pt.x, pt.y);
-      points.push_back(frame.points[i]->position());
-      index.push_back(i);
-    }
-    const PnpResult pnp = solvePnpRansac(pixels, points, camera_.K());
-    if (!pnp.success) continue;
-    for (std::size_t k = 0; k < index.size(); ++k) {
-      if (!pnp.inliers[k]) frame.points[index[k]] = nullptr;
-    }
-    frame.T_cw = pnp.camera_from_world;
-    optimizeFramePose(frame);
-    int inliers = discardOutliers(frame);
-    if (inliers < 50) {
-      std::vector<MapPoint*> found;
-      for (MapPoint* p : frame.points) {
-        if (p != nullptr) found.push_back(p);
-      }
-      matchKeyFrameByProjection(frame, *kf, found, 10.f, 100);
-      optimizeFramePose(frame);
-      inliers = discardOutliers(frame);
-    }
-    if (inliers >= 50) {
-      reference_keyframe_ = kf;
-      return true;
-    }
-  }
-  spdlog::debug("frame {}: not relocalised ({:.1f} ms)", frame.index, timer.elapsedMs());
-  std::fill(frame.points.begin(), frame.points.end(), nullptr);
-  frame.T_cw.reset();
-  return false;
+  FrameRelocalizationOptions options;
+  options.budget_ms = options_.relocalization_budget_ms;
+  const FrameRelocalization found =
+      relocalizeFrame(frame, relocalizationCandidates(frame), places_.get(), camera_, options);
+  if (found.keyframe == nullptr) return false;
+  reference_keyframe_ = found.keyframe;
+  relocalization_hint_ = kInvalidId;
+  return true;
 }
 
 void Tracker::updateLocalMap(const Frame& frame) {

@@ -9,7 +9,6 @@
 #include <optional>
 #include <vector>
 
-#include "client/keyframe_places.h"
 #include "client/keyframe_policy.h"
 #include "client/monocular_initializer.h"
 #include "client/tracking_diagnostics.h"
@@ -19,6 +18,8 @@
 #include "map/map.h"
 #include "map/map_participant.h"
 #include "map/pair_triangulation.h"
+#include "relocalize/frame_relocalization.h"
+#include "relocalize/keyframe_places.h"
 #include "util/timing_stats.h"
 
 namespace edgeslam {
@@ -112,6 +113,13 @@ class Tracker {
   // window only. Takes the map's update mutex (call from any thread, not inside track()).
   void onMapWindowChanged(const std::vector<KeyFrameId>& evicted,
                           const std::vector<KeyFrameId>& entered);
+  // Localisation through the edge: the map arrives in slices (none yet), and tracking starts lost
+  // so that no map of its own is begun. Relocalisation needs no vocabulary here: the edge finds
+  // the place (relocalizeNear).
+  void localizeInArrivingMap();
+  // The edge relocalised a recent frame against this keyframe (held in the client's map): the next
+  // lost frames try it and its neighbours first.
+  void relocalizeNear(KeyFrameId keyframe) { relocalization_hint_ = keyframe; }
   // Keyframes in the relocalisation database (0 without a vocabulary).
   std::size_t placesSize() const;
   std::size_t relocalizations() const { return relocalizations_; }
@@ -134,12 +142,10 @@ class Tracker {
   bool canRecoverByPrediction(std::size_t frame_index) const;
   bool relocalize(Frame& frame) REQUIRES(map_.updateMutex());
   std::vector<KeyFrame*> relocalizationCandidates(const Frame& frame) REQUIRES(map_.updateMutex());
-  int matchForRelocalization(KeyFrame& candidate, Frame& frame);
   void remember(KeyFrame* keyframe);
   int trackLocalMap(Frame& frame);
   void updateLocalMap(const Frame& frame);
   void addPointsFromLastFrameDepth(Frame& last);
-  int discardOutliers(Frame& frame);
   KeyFrameDecision decide(const Frame& frame, int inliers) const REQUIRES(map_.updateMutex());
   KeyFrame* createKeyFrame(Frame& frame) REQUIRES(map_.updateMutex());
   void triangulateAtKeyFrame(KeyFrame* keyframe, Frame& frame) REQUIRES(map_.updateMutex());
@@ -164,6 +170,8 @@ class Tracker {
   KeyFrame* reference_keyframe_ = nullptr;
   std::size_t last_keyframe_frame_ = 0;
   std::size_t last_relocalization_frame_ = 0;
+  KeyFrameId relocalization_hint_ = kInvalidId;
+  static constexpr std::size_t kRelocalizationHintNeighbours = 5;
   std::vector<KeyFrame*> local_keyframes_;
   std::vector<MapPoint*> local_points_;
   std::vector<FrameRecord> records_;

@@ -77,6 +77,10 @@ struct KeyFrameUpload {
   std::uint64_t acknowledged_slice = 0;  // last slice the client applied
   // Box NMS threshold nm for segmenting this and later keyframes (paper Table I); 0 = the edge's.
   float segmenter_nms = 0.f;
+  // A localise-only client's question about the frame in `keyframe` (see LocalizationAnswer): with
+  // keypoints and no parent, relocalise it; with a parent (the stored keyframe it tracks against),
+  // move its map window there. The edge's map takes nothing from it.
+  bool localization_query = false;
 };
 
 // A point that only moved: the receiver recomputes normal and distance range itself.
@@ -99,6 +103,17 @@ struct MaskRecord {
   std::string encoding;  // "png/N" (reduced N times) or "empty" (see semantic/label_encoding.h)
   std::vector<std::uint8_t> bytes;
   double segmentation_ms = 0.0;  // the edge's time to segment the keyframe
+};
+
+// Edge -> client: the answer to a localization_query upload.
+struct LocalizationAnswer {
+  std::uint64_t frame_index = 0;
+  bool found = false;
+  KeyFrameId keyframe = kInvalidId;  // the stored keyframe found against (the window's centre)
+  std::optional<SE3d> T_cw;          // the frame's pose in the map, when relocalised
+  std::uint32_t inliers = 0;
+  std::uint32_t candidates = 0;  // keyframes tried
+  double edge_ms = 0.0;
 };
 
 // Edge -> client: what changed in the global map since the last slice the client acknowledged.
@@ -129,6 +144,7 @@ struct MapSlice {
   // Size of the edge's global map when the slice was built (0 = not said: an older edge).
   std::uint64_t map_keyframes = 0;
   std::uint64_t map_points = 0;
+  std::optional<LocalizationAnswer> localization;  // answers a localization_query upload
 };
 
 }  // namespace edgeslam

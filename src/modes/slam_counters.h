@@ -53,6 +53,15 @@ struct MapCounters {
   double keyframe_depth_ratio = 0.0;
 };
 
+// Localisation through the edge (`--localize-only` in edge mode): the client's questions.
+struct EdgeLocalizationCounters {
+  std::uint64_t queries = 0;                 // sent
+  std::uint64_t relocalization_queries = 0;  // of those, lost frames for the edge to relocalise
+  std::uint64_t relocalized_by_edge = 0;     // answered with a pose
+  std::uint64_t window_moves = 0;            // tracked frames' window updates answered
+  PercentileSummary answer_ms;               // query sent -> its slice applied
+};
+
 struct SlamCounters {
   EdgeExchangeCounters exchange;
   SemanticCounters semantic;
@@ -60,6 +69,7 @@ struct SlamCounters {
   // How long tracking waited for the back end, and how often the back end refused keyframes.
   BackendPacing backend;
   MapCounters map;
+  EdgeLocalizationCounters localization;
 };
 
 }  // namespace edgeslam

@@ -1,5 +1,6 @@
 #include "modes/slam_session_backend.h"
 
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -38,6 +39,17 @@ OffloadTrackingState toOffloadState(TrackingState state) {
   }
 }
 
+MapSample sampleOf(const Map& map, std::size_t max_points) {
+  MapSample sample;
+  MutexLock lock(map.updateMutex());
+  for (const KeyFrame* kf : map.keyFrames()) {
+    if (!kf->isBad()) sample.keyframe_poses.push_back(kf->poseInverse());
+  }
+  sample.points = map.pointPositionSample(max_points);
+  sample.total_points = map.pointCount();
+  return sample;
+}
+
 }  // namespace
 
 SlamSessionBackend::SlamSessionBackend(const SessionConfig& config, SliceSink& sink,
@@ -50,6 +62,10 @@ SlamSessionBackend::SlamSessionBackend(const SessionConfig& config, SliceSink& s
       // A missing or broken model is the server's problem, but the session cannot be opened.
       throw std::invalid_argument(std::string("no segmenter for this session: ") + e.what());
     }
+  }
+  if (config_.settings.localize_only) {
+    makeLocalization();
+    return;
   }
   // A session naming a map the store holds resumes it (a client reconnecting after a restart):
   // loaded now, so that the full resync the client asks for first carries it.
@@ -166,12 +182,79 @@ void SlamSessionBackend::makeMapping(std::optional<StoredSession> resumed) {
                    stored_keyframes, places_missing);
 }
 
+void SlamSessionBackend::makeLocalization() {
+  if (!options_.store) {
+    throw std::invalid_argument(
+        "localisation needs a stored map, and this edge server keeps none (--maps none)");
+  }
+  if (config_.map_name.empty()) {
+    throw std::invalid_argument("localisation needs the name of a stored map (--map NAME)");
+  }
+  Stopwatch timer;
+  std::optional<StoredMap> stored;
+  try {
+    stored = options_.store->loadMap(config_.map_name);
+  } catch (const std::exception& e) {
+    throw std::invalid_argument(
+        fmt::format("map '{}' cannot be read: {}", config_.map_name, e.what()));
+  }
+  if (!stored) {
+    throw std::invalid_argument(
+        fmt::format("the edge's store {} has no map named '{}' to localise in",
+                    options_.store->location(), config_.map_name));
+  }
+  StoredSession* latest = latestSessionWithKeyFrames(*stored);
+  if (latest == nullptr) {
+    throw std::invalid_argument(fmt::format("map '{}' has no keyframes", config_.map_name));
+  }
+  if (latest->info.sensor != config_.sensor) {
+    throw std::invalid_argument(
+        fmt::format("map '{}' was made with a {} sensor; this client has a {} one",
+                    config_.map_name, toString(latest->info.sensor), toString(config_.sensor)));
+  }
+  const PinholeCamera& made_with = latest->info.camera;
+  if (made_with.width() != config_.camera.width() ||
+      made_with.height() != config_.camera.height()) {
+    throw std::invalid_argument(fmt::format(
+        "map '{}' was made with {}x{} images; this client's are {}x{}", config_.map_name,
+        made_with.width(), made_with.height(), config_.camera.width(), config_.camera.height()));
+  }
+  const double read_ms = timer.elapsedMs();
+  EdgeLocalizationSessionOptions options;
+  options.vocabulary = options_.mapping.backend.mapper.vocabulary
+                           ? options_.mapping.backend.mapper.vocabulary
+                           : options_.mapping.backend.vocabulary;
+  if (config_.settings.client_map_keyframes > 0) {
+    options.window_keyframes = static_cast<std::size_t>(config_.settings.client_map_keyframes);
+  }
+  MutexLock view_lock(view_mutex_);
+  localization_ = std::make_unique<EdgeLocalizationSession>(
+      config_.camera, options, [&](Map& map) { loadStoredSessionTakingFeatures(*latest, map); },
+      [this](MapSlice slice) { publish(std::move(slice)); });
+  spdlog::info(
+      "session {}: localising in map '{}' ({} keyframes, {} points), read-only: read in {:.0f} "
+      "ms, ready in {:.0f} ms",
+      config_.session_id, config_.map_name, localization_->keyFrameCount(), latest->points.size(),
+      read_ms, timer.elapsedMs());
+}
+
 void SlamSessionBackend::onKeyFrame(KeyFrameUpload upload) {
+  if (localization_) {
+    localization_->onQuery(upload);
+    return;
+  }
+  if (upload.localization_query) {
+    throw std::invalid_argument("a localisation query in a session that maps (not localize-only)");
+  }
   if (!mapping_) makeMapping(std::nullopt);
   mapping_->onKeyFrame(upload);
 }
 
 void SlamSessionBackend::onFullResyncRequested() {
+  if (localization_) {
+    localization_->publishFullResync();
+    return;
+  }
   // A session with nothing mapped yet (no stored map to resume) answers with an empty map: the
   // client then sends again every keyframe it holds.
   if (!mapping_) makeMapping(std::nullopt);
@@ -250,16 +333,9 @@ std::optional<std::string> SlamSessionBackend::failure() const {
 MapSample SlamSessionBackend::mapSample(std::size_t max_points) const {
   MutexLock view_lock(view_mutex_);
   if (offload_) return offload_->mapSample(max_points);
-  MapSample sample;
-  if (!mapping_) return sample;
-  const Map& map = mapping_->map();
-  MutexLock lock(map.updateMutex());
-  for (const KeyFrame* kf : map.keyFrames()) {
-    if (!kf->isBad()) sample.keyframe_poses.push_back(kf->poseInverse());
-  }
-  sample.points = map.pointPositionSample(max_points);
-  sample.total_points = map.pointCount();
-  return sample;
+  if (localization_) return sampleOf(localization_->map(), max_points);
+  if (mapping_) return sampleOf(mapping_->map(), max_points);
+  return {};
 }
 
 std::size_t SlamSessionBackend::loops() const {

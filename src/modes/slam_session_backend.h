@@ -7,6 +7,7 @@
 
 #include "modes/local_slam.h"
 #include "modes/slam_system.h"
+#include "server/edge_localization_session.h"
 #include "server/edge_map_session.h"
 #include "store/map_store_writer.h"
 #include "util/mutex.h"
@@ -48,6 +49,9 @@ class SlamSessionBackend : public EdgeSessionBackend {
   // The map's latest stored session with keyframes, when the session names a stored map.
   std::optional<StoredSession> storedSessionToResume();
   void makeMapping(std::optional<StoredSession> resumed);
+  // A localise-only session: the stored map it names, read-only. Throws std::invalid_argument when
+  // the edge cannot serve it (no store, no such map, another sensor, no vocabulary).
+  void makeLocalization();
   void startStoreWriter(std::optional<StoreSessionId> resumed,
                         const std::vector<KeyFrameId>& stored_keyframes,
                         const std::vector<KeyFrameId>& places_missing);
@@ -62,7 +66,8 @@ class SlamSessionBackend : public EdgeSessionBackend {
   std::shared_ptr<Segmenter> segmenter_;          // when the session asked for semantic culling
   std::unique_ptr<MapStoreWriter> store_writer_;  // outlives mapping_, which it observes
   std::unique_ptr<EdgeMapSession> mapping_;       // edge mode, made at the first keyframe
-  std::unique_ptr<LocalSlam> offload_;            // offload mode, made at the first frame
+  std::unique_ptr<EdgeLocalizationSession> localization_;  // localise-only edge sessions
+  std::unique_ptr<LocalSlam> offload_;                     // offload mode, made at the first frame
   std::uint64_t id_floor_ = 0;
   std::atomic<std::uint64_t> slices_split_{0};     // slices sent as several parts
   std::atomic<std::uint64_t> slices_not_sent_{0};  // slices that could not be sent (logged)

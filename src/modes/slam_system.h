@@ -193,6 +193,10 @@ class TrackingSlam : public SlamSystem {
   virtual void afterFrame() {}
   virtual void afterTracking(const TrackResult& /*result*/, std::size_t /*frame_index*/,
                              const cv::Mat& /*image*/) {}
+  // The features the last frame was tracked with (after semantic culling).
+  const std::shared_ptr<const FrameFeatures>& lastFrameFeatures() const {
+    return last_semantic_.kept;
+  }
   // The semantic stage's and the per-stage timing figures, for the subclasses' counters().
   void addClientCounters(SlamCounters& counters) const;
 

@@ -475,6 +475,7 @@ KeyFrameUpload fromProto(const v1::KeyFrameUpload& in) {
       throw WireError(fmt::format("segmenter NMS threshold {} outside [0, 1]", in.segmenter_nms()));
     }
     out.segmenter_nms = in.segmenter_nms();
+    out.localization_query = in.localization_query();
     const std::string& encoding = in.image_encoding();
     if (encoding.empty() != in.image().empty() ||
         !(encoding.empty() || encoding == "jpeg" || encoding == "png")) {
@@ -553,6 +554,24 @@ MapSlice fromProto(const v1::MapSlice& in) {
                                            "keyframes_evicted");
     out.map_keyframes = in.map_keyframes();
     out.map_points = in.map_points();
+    if (in.has_localization()) {
+      const v1::Localization& l = in.localization();
+      LocalizationAnswer a;
+      a.frame_index = l.frame_index();
+      a.found = l.found();
+      a.keyframe = l.keyframe();
+      if (a.found) requireId(a.keyframe, "localization.keyframe");
+      if (l.has_t_cw()) {
+        a.T_cw = within("localization pose", [&] { return fromProto(l.t_cw()); });
+      }
+      a.inliers = l.inliers();
+      a.candidates = l.candidates();
+      if (!std::isfinite(l.edge_ms()) || l.edge_ms() < 0.f) {
+        throw WireError(fmt::format("localization time {} ms", l.edge_ms()));
+      }
+      a.edge_ms = l.edge_ms();
+      out.localization = a;
+    }
     return out;
   });
 }
@@ -617,8 +636,12 @@ SessionConfig fromProto(const v1::OpenSessionRequest& in) {
       throw WireError(fmt::format("settings.client_map_keyframes {} exceeds {}",
                                   s.client_map_keyframes(), wire_limits::kMaxClientMapKeyFrames));
     }
-    out.settings = {static_cast<int>(s.features()), static_cast<int>(s.pyramid_levels()),
-                    s.scale_factor(), s.semantic(), static_cast<int>(s.client_map_keyframes())};
+    out.settings = {static_cast<int>(s.features()),
+                    static_cast<int>(s.pyramid_levels()),
+                    s.scale_factor(),
+                    s.semantic(),
+                    static_cast<int>(s.client_map_keyframes()),
+                    s.localize_only()};
     if (in.preferred_id_origin() > 255) {
       throw WireError(fmt::format("preferred_id_origin {} exceeds 255", in.preferred_id_origin()));
     }

@@ -383,6 +383,7 @@ void toProto(const KeyFrameUpload& upload, v1::KeyFrameUpload* out,
   out->set_acknowledged_slice(upload.acknowledged_slice);
   out->set_map_reset(upload.map_reset);
   out->set_segmenter_nms(upload.segmenter_nms);
+  out->set_localization_query(upload.localization_query);
 }
 
 void toProto(const MaskRecord& mask, v1::Mask* out) {
@@ -430,6 +431,17 @@ void toProto(const MapSlice& slice, v1::MapSlice* out, const WireEncodeOptions& 
   }
   out->set_map_keyframes(slice.map_keyframes);
   out->set_map_points(slice.map_points);
+  if (slice.localization) {
+    const LocalizationAnswer& a = *slice.localization;
+    v1::Localization* l = out->mutable_localization();
+    l->set_frame_index(a.frame_index);
+    l->set_found(a.found);
+    l->set_keyframe(a.keyframe);
+    if (a.T_cw) toProto(*a.T_cw, l->mutable_t_cw());
+    l->set_inliers(a.inliers);
+    l->set_candidates(a.candidates);
+    l->set_edge_ms(static_cast<float>(a.edge_ms));
+  }
 }
 
 void toProto(const SessionConfig& config, v1::OpenSessionRequest* out) {
@@ -470,6 +482,7 @@ void toProto(const SessionConfig& config, v1::OpenSessionRequest* out) {
   settings->set_semantic(config.settings.semantic);
   settings->set_client_map_keyframes(
       static_cast<std::uint32_t>(std::max(config.settings.client_map_keyframes, 0)));
+  settings->set_localize_only(config.settings.localize_only);
   out->set_preferred_id_origin(config.id_origin);
 }
 

@@ -22,6 +22,8 @@ struct SessionSettings {
   bool semantic = true;
   // Keyframes the client holds with features and points, around its latest one; 0 = unbounded.
   int client_map_keyframes = 0;
+  // Localise in the stored map named by SessionConfig::map_name, changing nothing in it.
+  bool localize_only = false;
 };
 
 // What a client opens a session with; id_origin and session_id are filled in by the server.

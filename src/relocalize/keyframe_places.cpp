@@ -1,4 +1,4 @@
-#include "client/keyframe_places.h"
+#include "relocalize/keyframe_places.h"
 
 #include <algorithm>
 #include <stdexcept>
@@ -36,6 +36,17 @@ std::shared_ptr<const KeyFramePlace> KeyFramePlaces::add(const KeyFrame& keyfram
   place->vocabulary = vocabulary_.get();
   places_[keyframe.id()] = place;
   return place;
+}
+
+std::shared_ptr<const KeyFramePlace> KeyFramePlaces::addDescribed(const KeyFrame& keyframe) {
+  const std::shared_ptr<const KeyFramePlace> described = keyframe.place();
+  if (described == nullptr || described->vocabulary != vocabulary_.get() ||
+      described->direct_index_depth != std::max(0, vocabulary_->levels() - kDirectIndexLevelsUp)) {
+    return add(keyframe);
+  }
+  database_.add(keyframe.id(), described->bow);
+  places_[keyframe.id()] = described;
+  return described;
 }
 
 std::size_t KeyFramePlaces::forgetIf(const std::function<bool(KeyFrameId)>& gone) {

@@ -22,6 +22,9 @@ class KeyFramePlaces {
   // Returns the keyframe's description (bag of words and direct index), which the caller may
   // attach to the keyframe (KeyFrame::setPlace) for bag-of-words triangulation.
   std::shared_ptr<const KeyFramePlace> add(const KeyFrame& keyframe);
+  // As add(), but a keyframe already described with this vocabulary at this direct-index depth (a
+  // stored map's bags of words) is filed with its description instead of being described again.
+  std::shared_ptr<const KeyFramePlace> addDescribed(const KeyFrame& keyframe);
   // A keyframe the client no longer holds (evicted from its bounded map); no-op when unknown.
   void erase(KeyFrameId id);
   void clear();
