@@ -30,6 +30,7 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DOCS = os.path.join(ROOT, "docs", "benchmarks.md")
 FIGURES = os.path.join(ROOT, "docs", "figures")
 BEGIN, END = "<!-- CLIENTS:BEGIN -->", "<!-- CLIENTS:END -->"
+LOCALIZE_BEGIN, LOCALIZE_END = "<!-- LOCALIZE-CLIENTS:BEGIN -->", "<!-- LOCALIZE-CLIENTS:END -->"
 TICKS = os.sysconf("SC_CLK_TCK")
 
 
@@ -47,12 +48,35 @@ def proc_sample(pid):
 
 
 def client_command(args, port, sensor, out_dir, name):
-    return [os.path.join(args.build, "edgeslam"), "client", "--server", f"127.0.0.1:{port}",
-            "--dataset", args.dataset, "--sensor", sensor, "--realtime",
-            "--max-frames", str(args.frames), "--map", name, "--out", out_dir]
+    command = [os.path.join(args.build, "edgeslam"), "client", "--server", f"127.0.0.1:{port}",
+               "--dataset", args.dataset, "--sensor", sensor, "--realtime",
+               "--max-frames", str(args.frames), "--out", out_dir]
+    if args.localize_only:
+        # Every client localises in the one map stored before the runs (stored_map below).
+        return command + ["--localize-only", "--map", stored_map_name(sensor),
+                          "--frames", args.localize_frames]
+    return command + ["--map", name]
+
+
+def stored_map_name(sensor):
+    return f"stored-{sensor}"
+
+
+def store_map(args, sensor, work):
+    """--localize-only: an edge run over the whole dataset maps it into the server's store."""
+    out_dir = os.path.join(work, "mapping")
+    with open(out_dir + ".log", "w") as log:
+        code = subprocess.call(
+            [os.path.join(args.build, "edgeslam"), "run", "--dataset", args.dataset, "--mode",
+             "edge", "--sensor", sensor, "--maps", os.path.join(work, "maps"), "--map",
+             stored_map_name(sensor), "--out", out_dir], stdout=log, stderr=subprocess.STDOUT)
+    if code != 0:
+        sys.exit(f"clients_bench: mapping the stored map failed (see {out_dir}.log)")
 
 
 def run_config(args, sensor, clients, work):
+    if args.localize_only:
+        store_map(args, sensor, work)
     port = free_port()
     server_log = os.path.join(work, "server.log")
     with open(server_log, "w") as log:
@@ -151,8 +175,12 @@ def fmt(v, digits=1):
 
 
 def table(results, args):
+    what = (f"frames {args.localize_frames} of {os.path.basename(args.dataset)} per session, "
+            "each client localising (`--localize-only`) in the map an edge run over the whole "
+            "dataset stored first" if args.localize_only else
+            f"{args.frames} frames of {os.path.basename(args.dataset)} per session")
     lines = [
-        f"{args.frames} frames of {os.path.basename(args.dataset)} per session at the camera's "
+        f"{what} at the camera's "
         f"rate, {args.passes} sessions in a row per client slot, edge mode, one server with a map "
         "store, all on this 2-core machine. e2e = frame arrival to pose (ms), the median over "
         "sessions of each session's p50 / p95, and the worst session's p95. Skipped late: frames "
@@ -203,14 +231,17 @@ def time_chart(path, title, results, column, y_label):
     write(path, svg_document(panel.x0 + panel.w + 160, panel.y0 + panel.h + 60, body, title))
 
 
-def update_docs(block):
+def update_docs(block, localize_only):
     with open(DOCS) as f:
         text = f.read()
-    section = f"{BEGIN}\n{block}\n{END}"
-    if BEGIN in text:
-        text = text[:text.index(BEGIN)] + section + text[text.index(END) + len(END):]
+    begin, end = (LOCALIZE_BEGIN, LOCALIZE_END) if localize_only else (BEGIN, END)
+    title = ("Localise-only clients on one server (`bench/clients_bench.py --localize-only`)"
+             if localize_only else "Many clients on one server (`bench/clients_bench.py`)")
+    section = f"{begin}\n{block}\n{end}"
+    if begin in text:
+        text = text[:text.index(begin)] + section + text[text.index(end) + len(end):]
     else:
-        text += f"\n## Many clients on one server (`bench/clients_bench.py`)\n\n{section}\n"
+        text += f"\n## {title}\n\n{section}\n"
     with open(DOCS, "w") as f:
         f.write(text)
 
@@ -227,6 +258,11 @@ def main():
     parser.add_argument("--frames", type=int, default=1000)
     parser.add_argument("--sample-s", type=float, default=1.0)
     parser.add_argument("--no-docs", action="store_true")
+    parser.add_argument("--localize-only", action="store_true",
+                        help="clients localise (--localize-only) in a map stored first by an "
+                             "edge run over the whole dataset, instead of mapping")
+    parser.add_argument("--localize-frames", default="500-999",
+                        help="with --localize-only: the frames each client plays")
     args = parser.parse_args()
     args.dataset = args.dataset or os.path.join(args.shared, "datasets/7scenes-redkitchen-1000")
     if not os.path.isdir(args.dataset):
@@ -251,7 +287,8 @@ def main():
     host = host_line(before, host_check(args.build, None))
     print(block + "\n\n" + host)
     if not args.no_docs:
-        update_docs(block + "\n\n" + host)
+        update_docs(block + "\n\n" + host, args.localize_only)
+    if not args.no_docs and not args.localize_only:
         time_chart(os.path.join(FIGURES, "clients_server_rss.svg"), "Edge server RSS",
                    results, 2, "RSS (MiB)")
         time_chart(os.path.join(FIGURES, "clients_server_cpu.svg"), "Edge server CPU",

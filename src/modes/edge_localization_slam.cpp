@@ -29,7 +29,9 @@ EdgeLocalizationSlam::EdgeLocalizationSlam(const PinholeCamera& camera, SlamOpti
   tracker_->localizeInArrivingMap();
 }
 
-EdgeLocalizationSlam::~EdgeLocalizationSlam() { link_->close(); }
+EdgeLocalizationSlam::~EdgeLocalizationSlam() {
+  link_->close();
+}
 
 void EdgeLocalizationSlam::onSlice(MapSlice slice) {
   const SliceApplyResult applied = applySlice(map_, slice, camera_);
@@ -127,7 +129,9 @@ void EdgeLocalizationSlam::waitForAnswer() {
   }
 }
 
-void EdgeLocalizationSlam::finish() { waitForAnswer(); }
+void EdgeLocalizationSlam::finish() {
+  waitForAnswer();
+}
 
 std::size_t EdgeLocalizationSlam::keyFrameCount() const {
   MutexLock lock(mutex_);

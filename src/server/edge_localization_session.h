@@ -30,8 +30,8 @@ struct EdgeLocalizationSessionOptions {
   std::size_t window_keyframes = 20;
   std::size_t relocalization_candidates = 10;
   // The edge has the time a client's frame does not: a wider budget than the tracker's 25 ms.
-  FrameRelocalizationOptions relocalization{.budget_ms = 80.0, .min_matches = 15,
-                                            .min_inliers = 50};
+  FrameRelocalizationOptions relocalization{
+      .budget_ms = 80.0, .min_matches = 15, .min_inliers = 50};
 };
 
 struct EdgeLocalizationStats {

@@ -384,6 +384,77 @@ TEST(WireConvert, SliceRoundTrip) {
   EXPECT_EQ(empty_back.map_points, 0u);
 }
 
+// A localise-only client's question and the edge's answer (issue 20): the query flag, a found
+// answer with its pose, a not-found one without; and the session setting.
+TEST(WireConvert, LocalisationQueryAndAnswerRoundTrip) {
+  std::mt19937 rng(8);
+  KeyFrameUpload question = test::sampleUpload(9, 120, 0, rng);
+  question.localization_query = true;
+  v1::KeyFrameUpload upload_message;
+  toProto(question, &upload_message);
+  EXPECT_TRUE(fromProto(reparsed(upload_message)).localization_query);
+  question.localization_query = false;
+  upload_message.Clear();
+  toProto(question, &upload_message);
+  EXPECT_FALSE(fromProto(reparsed(upload_message)).localization_query);
+
+  MapSlice slice;
+  slice.sequence = 4;
+  slice.upload_sequence = 9;
+  LocalizationAnswer answer;
+  answer.frame_index = 517;
+  answer.found = true;
+  answer.keyframe = (std::uint64_t{1} << 56) | 77;
+  answer.T_cw = SE3d(Eigen::Quaterniond(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitY())),
+                     Eigen::Vector3d(0.5, -0.2, 1.5));
+  answer.inliers = 212;
+  answer.candidates = 3;
+  answer.edge_ms = 14.5;
+  slice.localization = answer;
+  v1::MapSlice message;
+  toProto(slice, &message);
+  const MapSlice back = fromProto(reparsed(message));
+  ASSERT_TRUE(back.localization.has_value());
+  EXPECT_EQ(back.localization->frame_index, 517u);
+  EXPECT_TRUE(back.localization->found);
+  EXPECT_EQ(back.localization->keyframe, answer.keyframe);
+  ASSERT_TRUE(back.localization->T_cw.has_value());
+  expectPoseNear(*answer.T_cw, *back.localization->T_cw);
+  EXPECT_EQ(back.localization->inliers, 212u);
+  EXPECT_EQ(back.localization->candidates, 3u);
+  EXPECT_FLOAT_EQ(static_cast<float>(back.localization->edge_ms), 14.5f);
+
+  answer = LocalizationAnswer{};
+  answer.frame_index = 518;
+  slice.localization = answer;
+  message.Clear();
+  toProto(slice, &message);
+  const MapSlice not_found = fromProto(reparsed(message));
+  ASSERT_TRUE(not_found.localization.has_value());
+  EXPECT_FALSE(not_found.localization->found);
+  EXPECT_FALSE(not_found.localization->T_cw.has_value());
+  // An ordinary slice carries no answer.
+  slice.localization.reset();
+  message.Clear();
+  toProto(slice, &message);
+  EXPECT_FALSE(fromProto(reparsed(message)).localization.has_value());
+  // A found answer must name the keyframe it was found against.
+  LocalizationAnswer nameless;
+  nameless.found = true;
+  slice.localization = nameless;
+  message.Clear();
+  toProto(slice, &message);
+  EXPECT_THROW(fromProto(message), WireError);
+
+  SessionConfig config = test::sampleSessionConfig("walker");
+  config.settings.localize_only = true;
+  v1::OpenSessionRequest request;
+  toProto(config, &request);
+  EXPECT_TRUE(fromProto(request).settings.localize_only);
+  request.mutable_settings()->clear_localize_only();
+  EXPECT_FALSE(fromProto(request).settings.localize_only);
+}
+
 TEST(WireConvert, SessionConfigRoundTrip) {
   SessionConfig config = test::sampleSessionConfig("phone-7");
   config.id_origin = 42;
