@@ -230,7 +230,15 @@ void RunReport::printSummary() const {
                                                 : std::string("unbounded"));
   }
   const EdgeExchangeCounters& exchange = counters_.exchange;
-  if (options.mode != "local") {
+  const EdgeLocalizationCounters& asked = counters_.localization;
+  if (asked.queries > 0) {
+    fmt::print(
+        "  edge         {} questions ({} lost frames, {} relocalised by the edge; {} window "
+        "moves), answered in median {:.1f} ms p95 {:.1f} ms, {} B up, {} B down\n",
+        asked.queries, asked.relocalization_queries, asked.relocalized_by_edge, asked.window_moves,
+        asked.answer_ms.median, asked.answer_ms.p95, exchange.uplink_bytes,
+        exchange.downlink_bytes);
+  } else if (options.mode != "local") {
     fmt::print(
         "  edge         {} keyframes up, {} slices back, slice latency median {:.1f} ms p90 "
         "{:.1f} ms, {} B up, {} B down\n",
