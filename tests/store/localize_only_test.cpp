@@ -172,6 +172,12 @@ TEST_F(LocalizeOnly, AClientLocalisesThroughTheEdgeServerInItsStoredMap) {
                         " --frames 500-999 --sensor rgbd --localize-only --map kitchen" + *vocab_ +
                         " --out " + out.string());
   ASSERT_EQ(client.exit_code, 0) << client.output << server.log();
+  // A client lost later (the camera jumps back at the second pass) is found again by the edge.
+  const auto jump_out = test::freshTempDir("localize_edge_jump");
+  const auto jump = test::runEdgeslam("client --server " + address + " --dataset " + dataset() +
+                                      " --frames 600-799 --repeat 2 --sensor rgbd --localize-only" +
+                                      " --map kitchen" + *vocab_ + " --out " + jump_out.string());
+  ASSERT_EQ(jump.exit_code, 0) << jump.output << server.log();
   server.signal(SIGTERM);
   EXPECT_TRUE(server.wait(std::chrono::seconds(60)).has_value());
 
@@ -193,7 +199,14 @@ TEST_F(LocalizeOnly, AClientLocalisesThroughTheEdgeServerInItsStoredMap) {
   ASSERT_GE(pairs, 450u);
   EXPECT_LT(rms, 0.03) << pairs << " poses, RMS " << rms * 100 << " cm from the mapping run's";
   EXPECT_EQ(fileBytes(*store_ / "maps.sqlite"), store_before);
+
+  const auto jumped = readMetrics(jump_out);
+  SCOPED_TRACE(jumped.dump());
+  EXPECT_GE(jumped["tracked"].get<double>(), 0.95 * 400);
+  EXPECT_GE(jumped["localization"]["edge"]["relocalized_by_edge"].get<int>(), 2);
+  EXPECT_EQ(jumped["map_resets"], 0);
   std::filesystem::remove_all(out);
+  std::filesystem::remove_all(jump_out);
   std::filesystem::remove_all(logs);
 }
 
