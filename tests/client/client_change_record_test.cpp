@@ -4,6 +4,8 @@
 // that culled as much as it made still grew, ~7000 ids a pass of redkitchen 0-299.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "client/slice_applier.h"
 #include "map/synthetic_views.h"
 #include "support/mutex_unlock.h"
