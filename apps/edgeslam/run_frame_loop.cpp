@@ -83,7 +83,10 @@ void publishToViewer(RunCompanions& companions, const FrameLogEntry& logged, dou
 PlayedFrames playFrames(DatasetReader& reader, const FramePlan& plan, SlamSystem& slam,
                         RunCompanions& companions, const Stopwatch& wall) {
   PlayedFrames played;
+  // Records kept for every frame, reserved whole: grown by doubling they stepped up the heap of a
+  // long run (--repeat) and left the slack and the copies behind.
   played.frame_log.reserve(plan.frame_count);
+  if (reader.info().has_ground_truth) played.ground_truth.reserve(plan.frame_count);
   ProgressLine progress;
   std::size_t resets_seen = 0;
   // Paced runs play the dataset as a live camera: a client that falls behind takes the newest

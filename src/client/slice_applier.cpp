@@ -49,6 +49,11 @@ std::size_t carryNewerKeyFrames(Map& map, const MapSlice& slice, const SE3d& anc
 SliceApplyResult applySlice(Map& map, const MapSlice& slice, const PinholeCamera& camera) {
   SliceApplyResult result;
   MutexLock lock(map.updateMutex());
+  // What the client's map recorded of its own changes since the last slice is read by nobody (its
+  // uploads are built from its keyframes, not from the record): dropped here. Kept, the record held
+  // every point the client made whose erasure came with a slice, unrecorded (~7000 ids and
+  // ~0.25 MB of heap a pass of redkitchen 0-299, RGB-D, for good).
+  map.takeChanges();
   map.setChangeRecording(false);
   // Before the slice's erasures: a keyframe the edge culled as soon as it had mapped it (a
   // revisit) still tells how far mapping has come.

@@ -7,8 +7,9 @@
 // client does not hold are ignored. Keyframes the client made after the slice's keyframe, and the
 // points they made, follow that keyframe's correction rigidly. A slice with full_resync lists every
 // keyframe of the edge's map: the client takes each pose and point it carries, keeps what it made
-// that the edge lacks, and is told which keyframes those are (to send them again). Takes the map's
-// update mutex for the duration.
+// that the edge lacks, and is told which keyframes those are (to send them again). The map's record
+// of its own changes (Map::changes) is dropped: a client's is never read. Takes the map's update
+// mutex for the duration.
 #include <cstddef>
 #include <vector>
 
