@@ -78,11 +78,11 @@ TEST(KeyFramePolicy, WhileMapUpdatesArePausedOnlyTheKeyFrameGapForces) {
 TEST(KeyFramePolicy, WhileMapUpdatesArePausedTheViewChangeCountsEveryReferencePoint) {
   KeyFrameEvidence e = healthy();
   e.frames_since_keyframe = 21;
-  e.frames_since_map_update = 100;
   e.frame_tracked = 200;
   e.reference_tracked = 120;  // 200 tracked against 120 seen by 3 keyframes: "unchanged"
   e.reference_points = 300;   // but a third of the reference keyframe's points are out of view
   EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kNo);
+  e.frames_since_map_update = 100;  // the edge is down
   e.map_updates_paused = true;
   EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kYes);
   e.frame_tracked = 280;  // most of them still in view
