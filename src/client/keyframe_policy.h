@@ -19,6 +19,7 @@
 // keyframes see: no mapper adds observations to the points made during the outage, so few of them
 // ever counted, the frame (which counts every point it tracks) stayed above beta of the rest, and
 // only rule (2) made keyframes: 5 in the 140 frames of a server restart against 11-12 undisturbed.
+// And rule (1) is the keyframe gap alone: the outage's keyframes come at the undisturbed pace.
 // Guard (why: with fmin = 10-40 frames, fast motion would lose tracking before the next keyframe is
 // allowed): when the tracked ratio falls below `starving_ratio`, rule (1) is waived.
 // Segmentation refresh (semantic culling on): people who walk into view appear in the movable mask

@@ -90,6 +90,14 @@ TEST(KeyFramePolicy, WhileMapUpdatesArePausedTheViewChangeCountsEveryReferencePo
   e.frame_tracked = 200;
   e.frames_since_keyframe = 20;  // and fmin as ever
   EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kNo);
+  // even in a map of fewer than fmin keyframes (fmin 40 on a slow link): a keyframe per frame
+  // would pile up uploads the edge answers one by one once back.
+  e.keyframes_in_map = 10;
+  EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kNo);
+  e.map_updates_paused = false;
+  e.frames_since_map_update = 5;
+  e.frame_tracked = 100;  // 100 / 120
+  EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kYes);
 }
 
 TEST(KeyFramePolicy, Rule3RejectsPoorImages) {

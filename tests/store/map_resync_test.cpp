@@ -2,6 +2,10 @@
 // real binaries, two processes, redkitchen at frame rate. The restarted server resumes the stored
 // map, the client reconnects, receives a full resync, and re-sends the keyframes the edge lacks.
 // Compared with the same run undisturbed: edge keyframes, keyframe ATE, client frames.
+// Both runs keep the keyframe rules of the loopback link (`--adapt off`; it still probes): on a
+// loaded host the adaptation loop measures the host, not the link, and moved undisturbed runs
+// between fmin 10 and fmin 40 at its own moments (45-85 keyframes), which no bound on the
+// killed/undisturbed ratio survives. What the outage did to the adaptation is asserted apart.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <unistd.h>
@@ -87,8 +91,8 @@ RunFigures runClient(const std::string& name, std::optional<std::chrono::millise
   test::ChildProcess client(
       test::edgeslamBinary(),
       words("client --server " + address + " --dataset " + test::sharedPath(kSequence).string() +
-            " --sensor rgbd --realtime --vocab " + vocabularyPath() + " --map kitchen --out " +
-            out.string()),
+            " --sensor rgbd --realtime --adapt off --vocab " + vocabularyPath() +
+            " --map kitchen --out " + out.string()),
       logs / "client.log");
   if (kill_after) {
     EXPECT_TRUE(server->waitForLog("opened for", kServerReady)) << server->log();
@@ -157,6 +161,12 @@ TEST(MapResync, ServerKilledAndRestartedOnItsStoreLosesNoKeyframe) {
 
   // The client saw the outage and was resynchronised.
   EXPECT_GE(m["resync"]["full_resyncs"].get<int>(), 1) << m["resync"].dump();
+  // The probes of the outage (2 s, and the restarted server's start) failed with the edge
+  // unreachable and were no samples of the link. Before, each became a 1 s round trip and the
+  // loop moved to the slowest configuration (fmin 40) for the outage and ~10 s after it.
+  ASSERT_TRUE(m["adapt"].is_object());
+  EXPECT_GE(m["adapt"].value("unreachable_probes", 0), 2) << m["adapt"].dump();
+  EXPECT_LE(m["adapt"]["failed_probes"].get<int>(), 1) << m["adapt"].dump();
   // The restarted server resumed the stored session instead of starting an empty one.
   EXPECT_EQ(killed.map_info["sessions"], 1) << killed.map_info.dump();
   // No frame of the client lost.
