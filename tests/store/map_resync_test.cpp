@@ -187,12 +187,13 @@ TEST(MapResync, ServerKilledAndRestartedOnItsStoreLosesNoKeyframe) {
   const double culled = m["resync"]["keyframes_culled_by_edge"].get<double>();
   EXPECT_GE(killed.map_info["keyframes"].get<double>() + culled + lost, 0.97 * made)
       << m["resync"].dump();
-  // And not far from what an undisturbed run holds. The two runs decide their keyframes apart
-  // (the live camera skips other frames; a resynchronised client tracks a denser map and makes
-  // fewer): 70-108 measured against 88-99 undisturbed. The issue's bug, the keyframes before the
-  // outage lost, left about 40 %.
+  // And as many as an undisturbed run holds: the issue asks >= 95 % of it, which the median of
+  // runs meets (docs/map_store.md, Keyframes after a restart: 94-117 % of the undisturbed
+  // median); one pair on a loaded host spreads more (91-108 % measured), hence the margin.
+  // Before, 52-91 % (the outage's probes switched to fmin 40; the outage's keyframes came at
+  // rule 2's pace only); the issue's bug, the keyframes before the outage lost, left about 40 %.
   const double calm_keyframes = calm.map_info["keyframes"].get<double>();
-  EXPECT_GE(killed.map_info["keyframes"].get<double>(), 0.6 * calm_keyframes);
+  EXPECT_GE(killed.map_info["keyframes"].get<double>(), 0.85 * calm_keyframes);
   // Keyframe accuracy: within 10 % of the undisturbed run's, or 1 cm (run-to-run spread).
   ASSERT_GT(calm.keyframe_ate_m, 0.0);
   ASSERT_GT(killed.keyframe_ate_m, 0.0);
