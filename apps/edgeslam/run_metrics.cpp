@@ -47,6 +47,7 @@ nlohmann::json adaptationJson(const AdaptationLoop& loop) {
           {"frames_per_config", c.frames_per_config},
           {"probe_bytes", c.probe_bytes},
           {"failed_probes", c.failed_probes},
+          {"unreachable_probes", c.unreachable_probes},
           {"latency_ms", optional_json(n.latency_ms)},
           {"bandwidth_mbps", optional_json(n.bandwidth_mbps)},
           {"network_time_ms", optional_json(n.network_time_ms)},

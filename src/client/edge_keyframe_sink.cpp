@@ -66,6 +66,7 @@ void EdgeKeyFrameSink::sendUpload(KeyFrame* keyframe, bool resend) {
     if (recent_uploads_.size() > kRememberedUploads) recent_uploads_.pop_front();
     // Set under the lock, so that onUploadDropped sees whether a later upload was built.
     sequence_ = upload.sequence;
+    if (resend || uplink_.reconnecting()) backlog_last_sequence_ = upload.sequence;
   }
   {
     MutexLock lock(sent_mutex_);
@@ -81,9 +82,17 @@ void EdgeKeyFrameSink::attachImage(std::size_t frame_index, cv::Mat image) {
 }
 
 std::uint64_t EdgeKeyFrameSink::uploadsInFlight() const {
+  return inFlightAbove(0);
+}
+
+std::uint64_t EdgeKeyFrameSink::uploadsInFlightAfterBacklog() const {
+  return inFlightAbove(backlog_last_sequence_.load());
+}
+
+std::uint64_t EdgeKeyFrameSink::inFlightAbove(std::uint64_t floor) const {
   MutexLock lock(sent_mutex_);
   const std::uint64_t sent = sequence_.load();
-  const std::uint64_t answered = answered_.load();
+  const std::uint64_t answered = std::max(answered_.load(), floor);
   if (sent <= answered) return 0;
   const auto dropped = static_cast<std::uint64_t>(std::count_if(
       dropped_unanswered_.begin(), dropped_unanswered_.end(),
@@ -91,17 +100,18 @@ std::uint64_t EdgeKeyFrameSink::uploadsInFlight() const {
   return sent - answered - std::min(dropped, sent - answered);
 }
 
+bool EdgeKeyFrameSink::withinBounds(std::size_t limit) const {
+  if (uplink_.reconnecting()) return uploadsInFlight() < options_.max_in_flight_reconnecting;
+  return uploadsInFlightAfterBacklog() < limit &&
+         uploadsInFlight() < std::max(limit, options_.max_in_flight_reconnecting);
+}
+
 bool EdgeKeyFrameSink::acceptsKeyFrames() const {
-  const std::size_t limit =
-      uplink_.reconnecting() ? options_.max_in_flight_reconnecting : options_.max_in_flight;
-  return uploadsInFlight() < limit;
+  return withinBounds(options_.max_in_flight);
 }
 
 bool EdgeKeyFrameSink::acceptsUrgentKeyFrames() const {
-  const std::size_t limit = uplink_.reconnecting()
-                                ? options_.max_in_flight_reconnecting
-                                : options_.max_in_flight + options_.urgent_extra_in_flight;
-  return uploadsInFlight() < limit;
+  return withinBounds(options_.max_in_flight + options_.urgent_extra_in_flight);
 }
 
 void EdgeKeyFrameSink::onMapReset() {

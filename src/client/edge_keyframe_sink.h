@@ -76,6 +76,13 @@ class EdgeKeyFrameSink : public KeyFrameSink {
   std::uint64_t uploadsAnswered() const { return answered_.load(); }
   // Uploads that may still be answered by a slice (sent, not answered, not dropped).
   std::uint64_t uploadsInFlight() const;
+  // Of those, the ones sent after the last outage's backlog (the uploads sent while the edge was
+  // unreachable, and those sent again after its restart): the bounds above apply to these once
+  // the edge is back, and max_in_flight_reconnecting to all. The edge answers the backlog in
+  // order, a second or more per keyframe on a loaded host; counted against max_in_flight it
+  // refused tracking every keyframe until then, and tracking was lost (14 keyframes of a server
+  // restart in flight, no keyframe for 2 s, lost at the next turn for 200 frames).
+  std::uint64_t uploadsInFlightAfterBacklog() const;
   bool allAnswered() const { return uploadsInFlight() == 0; }
   std::uint64_t keyFramesForgotten() const { return keyframes_forgotten_.load(); }
   std::uint64_t pointsForgotten() const { return points_forgotten_.load(); }
@@ -93,6 +100,11 @@ class EdgeKeyFrameSink : public KeyFrameSink {
   static constexpr std::size_t kRememberedUploads = 64;
 
   void sendUpload(KeyFrame* keyframe, bool resend);
+  // Uploads in flight with a sequence above `floor`.
+  std::uint64_t inFlightAbove(std::uint64_t floor) const;
+  // Whether `limit` uploads after the backlog (all of them while reconnecting: the reconnecting
+  // bound) leave room for one more.
+  bool withinBounds(std::size_t limit) const;
 
   Map& map_;
   KeyFrameUplink& uplink_;
@@ -110,7 +122,8 @@ class EdgeKeyFrameSink : public KeyFrameSink {
   mutable Mutex sent_mutex_;
   std::deque<std::pair<std::uint64_t, Clock::time_point>> sent_times_ GUARDED_BY(sent_mutex_);
   std::set<std::uint64_t> dropped_unanswered_
-      GUARDED_BY(sent_mutex_);  // dropped sequences above answered_
+      GUARDED_BY(sent_mutex_);                           // dropped sequences above answered_
+  std::atomic<std::uint64_t> backlog_last_sequence_{0};  // last upload of the outage's backlog
   std::atomic<std::uint64_t> keyframes_forgotten_{0};
   std::atomic<std::uint64_t> keyframes_resent_{0};
   std::atomic<std::uint64_t> points_forgotten_{0};

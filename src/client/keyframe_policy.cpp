@@ -31,9 +31,16 @@ KeyFrameDecision decideKeyFrame(const KeyFrameParameters& params, const KeyFrame
       e.mapper_accepts) {
     return KeyFrameDecision::kYesForSegmentation;
   }
-  const bool rule1 = e.frames_since_keyframe > static_cast<std::size_t>(params.fmin) ||
-                     e.keyframes_in_map < static_cast<std::size_t>(params.fmin);
-  const bool rule4 = tracked_ratio < params.beta;
+  // While paused, the gap alone: "fewer than fmin keyframes in the map" (fmin is 40 on a slow
+  // link) then let every frame whose view changed become one, 23 keyframes in the 190 frames of
+  // an outage, which the edge took seconds to answer once back.
+  const bool rule1 =
+      e.frames_since_keyframe > static_cast<std::size_t>(params.fmin) ||
+      (!e.map_updates_paused && e.keyframes_in_map < static_cast<std::size_t>(params.fmin));
+  const std::size_t view_reference =
+      e.map_updates_paused && e.reference_points > 0 ? e.reference_points : e.reference_tracked;
+  const bool rule4 = view_reference == 0 || static_cast<double>(e.frame_tracked) <
+                                                params.beta * static_cast<double>(view_reference);
   if (rule1 && rule4 && e.mapper_accepts) return KeyFrameDecision::kYes;
   return KeyFrameDecision::kNo;
 }

@@ -15,6 +15,11 @@
 // map updates are paused (the edge unreachable) only the keyframe gap counts for (2): the update
 // is overdue because of the outage, and forcing a keyframe per frame spent the whole allowance of
 // unanswered keyframes in the outage's first seconds, leaving tracking none for the rest of it.
+// Then rule (4) also compares against every point of the reference keyframe, not only those 3
+// keyframes see: no mapper adds observations to the points made during the outage, so few of them
+// ever counted, the frame (which counts every point it tracks) stayed above beta of the rest, and
+// only rule (2) made keyframes: 5 in the 140 frames of a server restart against 11-12 undisturbed.
+// And rule (1) is the keyframe gap alone: the outage's keyframes come at the undisturbed pace.
 // Guard (why: with fmin = 10-40 frames, fast motion would lose tracking before the next keyframe is
 // allowed): when the tracked ratio falls below `starving_ratio`, rule (1) is waived.
 // Segmentation refresh (semantic culling on): people who walk into view appear in the movable mask
@@ -43,6 +48,7 @@ struct KeyFrameEvidence {
   std::size_t reference_features = 0;
   std::size_t frame_tracked = 0;      // inlier matches to map points in this frame
   std::size_t reference_tracked = 0;  // points of the reference keyframe seen by >= 2 keyframes
+  std::size_t reference_points = 0;   // every point of the reference keyframe (0 = not given)
   bool mapper_accepts = true;         // false while the mapper is too busy to take one
   bool mapper_accepts_urgent = true;  // the same for a keyframe of starving tracking
   bool map_updates_paused = false;    // no update can come for now (the edge is unreachable)

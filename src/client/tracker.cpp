@@ -517,6 +517,7 @@ KeyFrameDecision Tracker::decide(const Frame& frame, int inliers) const {
   e.frame_tracked = static_cast<std::size_t>(inliers);
   const int min_obs = e.keyframes_in_map <= 2 ? 2 : 3;
   e.reference_tracked = static_cast<std::size_t>(reference_keyframe_->trackedPointCount(min_obs));
+  e.reference_points = static_cast<std::size_t>(reference_keyframe_->trackedPointCount(1));
   e.mapper_accepts = sink_ == nullptr || sink_->acceptsKeyFrames();
   e.mapper_accepts_urgent = sink_ == nullptr || sink_->acceptsUrgentKeyFrames();
   e.map_updates_paused = sink_ != nullptr && sink_->mapUpdatesPaused();

@@ -26,11 +26,13 @@ std::string formatEstimate(std::optional<double> value, const char* unit) {
 }  // namespace
 
 AdaptationLoop::AdaptationLoop(EdgeClient& client, AdaptationLoopOptions options)
-    : AdaptationLoop(probeThrough(client), options) {}
+    : AdaptationLoop(probeThrough(client), options, [&client] { return client.connected(); }) {}
 
-AdaptationLoop::AdaptationLoop(ProbeFunction probe, AdaptationLoopOptions options)
+AdaptationLoop::AdaptationLoop(ProbeFunction probe, AdaptationLoopOptions options,
+                               ReachabilityFunction edge_reachable)
     : options_(options),
       probe_(std::move(probe)),
+      edge_reachable_(std::move(edge_reachable)),
       controller_(options.controller),
       scheduler_(options.schedule),
       estimator_(options.controller.estimator_window),
@@ -119,6 +121,7 @@ AdaptationLoopCounters AdaptationLoop::counters() const {
   out.latency_probes = latency_probes_;
   out.bandwidth_probes = bandwidth_probes_;
   out.failed_probes = failed_probes_;
+  out.unreachable_probes = unreachable_probes_;
   return out;
 }
 
@@ -165,15 +168,22 @@ AdaptationLoop::ProbeOutcome AdaptationLoop::timedProbe(std::size_t payload_byte
       probe_(payload_bytes, reply_bytes, options_.probe_timeout);
   const double elapsed_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
   const std::size_t wire = estimatedProbeWireBytes(payload_bytes, reply_bytes);
+  const bool unreachable = !result && edge_reachable_ && !edge_reachable_();
   MutexLock lock(state_mutex_);
   probe_bytes_ += wire;
+  if (unreachable) {
+    ++unreachable_probes_;
+    spdlog::debug("adaptation: probe of {} B failed with the edge unreachable: no sample",
+                  payload_bytes);
+    return {elapsed_ms, false, true};
+  }
   if (!result) {
     ++failed_probes_;
     const double timeout_ms =
         std::chrono::duration<double, std::milli>(options_.probe_timeout).count();
     spdlog::debug("adaptation: probe of {} B unanswered after {:.0f} ms", payload_bytes,
                   elapsed_ms);
-    return {std::max(elapsed_ms, timeout_ms), false};
+    return {std::max(elapsed_ms, timeout_ms), false, false};
   }
   probe_uplink_bytes_ += result->sent_bytes;
   probe_downlink_bytes_ += result->received_bytes;
@@ -182,7 +192,9 @@ AdaptationLoop::ProbeOutcome AdaptationLoop::timedProbe(std::size_t payload_byte
 
 void AdaptationLoop::probeLatency() {
   const std::size_t payload = options_.schedule.small_payload_bytes;
-  const double rtt_ms = timedProbe(payload, payload).elapsed_ms;
+  const ProbeOutcome outcome = timedProbe(payload, payload);
+  if (outcome.unreachable) return;
+  const double rtt_ms = outcome.elapsed_ms;
   {
     MutexLock lock(state_mutex_);
     ++latency_probes_;
@@ -205,6 +217,7 @@ void AdaptationLoop::probeBandwidth() {
   const std::size_t payload = scheduler_.sizedProbeBytes(bandwidth);
   const std::size_t reply = options_.schedule.small_payload_bytes;
   const ProbeOutcome outcome = timedProbe(payload, reply);
+  if (outcome.unreachable) return;
   double elapsed_ms = outcome.elapsed_ms;
   {
     MutexLock lock(state_mutex_);

@@ -544,6 +544,10 @@ bool EdgeClient::reconnecting() const {
   return impl_->reconnecting.load();
 }
 
+bool EdgeClient::connected() const {
+  return impl_->channel->GetState(false) == GRPC_CHANNEL_READY;
+}
+
 std::vector<KeyFrameId> EdgeClient::pendingUploadKeyFrames() const {
   MutexLock lock(impl_->mutex);
   std::vector<KeyFrameId> out = impl_->acknowledged_while_resyncing;

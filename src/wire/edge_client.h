@@ -110,6 +110,9 @@ class EdgeClient {
   // The last upload attempt failed for want of the server (unreachable, or its session lost and
   // not reopened yet); false again once an upload goes through.
   bool reconnecting() const;
+  // The channel to the server is connected now (false while the server is down or being reached
+  // again). A probe that failed while this is false measured an outage, not the link.
+  bool connected() const;
   // Keyframes on their way to the session's map: uploads queued or being sent, and those the
   // session acknowledged while a full resync was pending (the resync's slice may have been taken
   // before they arrived). A keyframe a full resync does not list and this does not name is lost.

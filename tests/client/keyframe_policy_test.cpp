@@ -71,6 +71,35 @@ TEST(KeyFramePolicy, WhileMapUpdatesArePausedOnlyTheKeyFrameGapForces) {
   EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kYesStarving);
 }
 
+// A server restart (issue 19): the points the client made during the outage are seen by one or
+// two of its keyframes only (no mapper fuses them), so the frame tracks more points than the
+// reference keyframe has seen by 3 keyframes, and rule (4) never held. Against every point of the
+// reference keyframe the view change shows.
+TEST(KeyFramePolicy, WhileMapUpdatesArePausedTheViewChangeCountsEveryReferencePoint) {
+  KeyFrameEvidence e = healthy();
+  e.frames_since_keyframe = 21;
+  e.frame_tracked = 200;
+  e.reference_tracked = 120;  // 200 tracked against 120 seen by 3 keyframes: "unchanged"
+  e.reference_points = 300;   // but a third of the reference keyframe's points are out of view
+  EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kNo);
+  e.frames_since_map_update = 100;  // the edge is down
+  e.map_updates_paused = true;
+  EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kYes);
+  e.frame_tracked = 280;  // most of them still in view
+  EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kNo);
+  e.frame_tracked = 200;
+  e.frames_since_keyframe = 20;  // and fmin as ever
+  EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kNo);
+  // even in a map of fewer than fmin keyframes (fmin 40 on a slow link): a keyframe per frame
+  // would pile up uploads the edge answers one by one once back.
+  e.keyframes_in_map = 10;
+  EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kNo);
+  e.map_updates_paused = false;
+  e.frames_since_map_update = 5;
+  e.frame_tracked = 100;  // 100 / 120
+  EXPECT_EQ(decideKeyFrame({}, e), KeyFrameDecision::kYes);
+}
+
 TEST(KeyFramePolicy, Rule3RejectsPoorImages) {
   KeyFrameEvidence e = healthy();
   e.frames_since_map_update = 100;

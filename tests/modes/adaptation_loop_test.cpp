@@ -4,6 +4,7 @@
 #include <sched.h>
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <memory>
@@ -223,6 +224,35 @@ TEST(AdaptationLoop, UnansweredProbesCountAsAVerySlowLink) {
   EXPECT_GE(loop.counters().failed_probes, 2u);
   EXPECT_GE(*loop.estimates().latency_ms, 400.0);
   loop.stop();
+}
+
+TEST(AdaptationLoop, AnOutageOfTheEdgeIsNoSampleOfTheLink) {
+  // The edge goes away (a server killed and restarted, issue 19): probes fail with the channel
+  // down. Taken as 1 s round trips they switched a loopback client to the slowest row for the
+  // outage and ~10 s after it; they are counted apart and the configuration stays.
+  auto server = std::make_unique<EdgeServer>("127.0.0.1:0", std::make_shared<IdleFactory>());
+  EdgeClient client("127.0.0.1:" + std::to_string(server->port()), probeSessionConfig());
+  EXPECT_TRUE(client.connected());
+  AdaptationLoop loop(client, fastOptions(5000.0));
+  loop.start();
+  ASSERT_TRUE(eventually([&] { return loop.estimates().network_time_ms.has_value(); },
+                         milliseconds(10000)));
+  server->shutdown();
+  server.reset();
+  const std::uint64_t version = loop.version();
+  const std::size_t row = loop.row();
+  const double latency_ms = *loop.estimates().latency_ms;
+  ASSERT_TRUE(
+      eventually([&] { return loop.counters().unreachable_probes >= 8; }, milliseconds(10000)))
+      << "failed " << loop.counters().failed_probes;
+  EXPECT_FALSE(client.connected());
+  // At most the probe in flight when the server went, failing before the channel knew.
+  EXPECT_LE(loop.counters().failed_probes, 1u);
+  EXPECT_EQ(loop.version(), version);
+  EXPECT_EQ(loop.row(), row);
+  EXPECT_LT(*loop.estimates().latency_ms, std::max(100.0, 2.0 * latency_ms));
+  loop.stop();
+  client.close();
 }
 
 TEST(AdaptationLoop, StopReturnsWhileAProbeIsStuck) {

@@ -2,6 +2,10 @@
 // real binaries, two processes, redkitchen at frame rate. The restarted server resumes the stored
 // map, the client reconnects, receives a full resync, and re-sends the keyframes the edge lacks.
 // Compared with the same run undisturbed: edge keyframes, keyframe ATE, client frames.
+// Both runs keep the keyframe rules of the loopback link (`--adapt off`; it still probes): on a
+// loaded host the adaptation loop measures the host, not the link, and moved undisturbed runs
+// between fmin 10 and fmin 40 at its own moments (45-85 keyframes), which no bound on the
+// killed/undisturbed ratio survives. What the outage did to the adaptation is asserted apart.
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <unistd.h>
@@ -87,8 +91,8 @@ RunFigures runClient(const std::string& name, std::optional<std::chrono::millise
   test::ChildProcess client(
       test::edgeslamBinary(),
       words("client --server " + address + " --dataset " + test::sharedPath(kSequence).string() +
-            " --sensor rgbd --realtime --vocab " + vocabularyPath() + " --map kitchen --out " +
-            out.string()),
+            " --sensor rgbd --realtime --adapt off --vocab " + vocabularyPath() +
+            " --map kitchen --out " + out.string()),
       logs / "client.log");
   if (kill_after) {
     EXPECT_TRUE(server->waitForLog("opened for", kServerReady)) << server->log();
@@ -149,14 +153,21 @@ TEST(MapResync, ServerKilledAndRestartedOnItsStoreLosesNoKeyframe) {
     return std::string(line);
   };
   std::printf(
-      "undisturbed: %s\nkilled:      %s; resync %s\n"
+      "undisturbed: %s\nkilled:      %s; resync %s; adapt %s\n"
       "killed/undisturbed: edge keyframes %.0f %%, keyframe ATE %.2f\n",
       describe(calm).c_str(), describe(killed).c_str(), m["resync"].dump().c_str(),
+      m.value("adapt", nlohmann::json()).dump().c_str(),
       100.0 * killed.map_info["keyframes"].get<double>() / calm.map_info["keyframes"].get<double>(),
       killed.keyframe_ate_m / calm.keyframe_ate_m);
 
   // The client saw the outage and was resynchronised.
   EXPECT_GE(m["resync"]["full_resyncs"].get<int>(), 1) << m["resync"].dump();
+  // The probes of the outage (2 s, and the restarted server's start) failed with the edge
+  // unreachable and were no samples of the link. Before, each became a 1 s round trip and the
+  // loop moved to the slowest configuration (fmin 40) for the outage and ~10 s after it.
+  ASSERT_TRUE(m.contains("adapt") && m["adapt"].is_object()) << m.dump();
+  EXPECT_GE(m["adapt"].value("unreachable_probes", 0), 2) << m["adapt"].dump();
+  EXPECT_LE(m["adapt"]["failed_probes"].get<int>(), 1) << m["adapt"].dump();
   // The restarted server resumed the stored session instead of starting an empty one.
   EXPECT_EQ(killed.map_info["sessions"], 1) << killed.map_info.dump();
   // No frame of the client lost.
@@ -177,12 +188,13 @@ TEST(MapResync, ServerKilledAndRestartedOnItsStoreLosesNoKeyframe) {
   const double culled = m["resync"]["keyframes_culled_by_edge"].get<double>();
   EXPECT_GE(killed.map_info["keyframes"].get<double>() + culled + lost, 0.97 * made)
       << m["resync"].dump();
-  // And not far from what an undisturbed run holds. The two runs decide their keyframes apart
-  // (the live camera skips other frames; a resynchronised client tracks a denser map and makes
-  // fewer): 70-108 measured against 88-99 undisturbed. The issue's bug, the keyframes before the
-  // outage lost, left about 40 %.
+  // And as many as an undisturbed run holds: the issue asks >= 95 % of it, which the median of
+  // runs meets (docs/map_store.md, Keyframes after a restart: 94-117 % of the undisturbed
+  // median); one pair on a loaded host spreads more (91-108 % measured), hence the margin.
+  // Before, 52-91 % (the outage's probes switched to fmin 40; the outage's keyframes came at
+  // rule 2's pace only); the issue's bug, the keyframes before the outage lost, left about 40 %.
   const double calm_keyframes = calm.map_info["keyframes"].get<double>();
-  EXPECT_GE(killed.map_info["keyframes"].get<double>(), 0.6 * calm_keyframes);
+  EXPECT_GE(killed.map_info["keyframes"].get<double>(), 0.85 * calm_keyframes);
   // Keyframe accuracy: within 10 % of the undisturbed run's, or 1 cm (run-to-run spread).
   ASSERT_GT(calm.keyframe_ate_m, 0.0);
   ASSERT_GT(killed.keyframe_ate_m, 0.0);
