@@ -37,10 +37,12 @@ KeyFrameDecision decideKeyFrame(const KeyFrameParameters& params, const KeyFrame
   const bool rule1 =
       e.frames_since_keyframe > static_cast<std::size_t>(params.fmin) ||
       (!e.map_updates_paused && e.keyframes_in_map < static_cast<std::size_t>(params.fmin));
-  const std::size_t view_reference =
-      e.map_updates_paused && e.reference_points > 0 ? e.reference_points : e.reference_tracked;
-  const bool rule4 = view_reference == 0 || static_cast<double>(e.frame_tracked) <
-                                                params.beta * static_cast<double>(view_reference);
+  // The undisturbed case keeps its ratio exactly as before (a deterministic run stays the same).
+  const bool rule4 =
+      e.map_updates_paused && e.reference_points > 0
+          ? static_cast<double>(e.frame_tracked) / static_cast<double>(e.reference_points) <
+                params.beta
+          : tracked_ratio < params.beta;
   if (rule1 && rule4 && e.mapper_accepts) return KeyFrameDecision::kYes;
   return KeyFrameDecision::kNo;
 }
