@@ -517,10 +517,13 @@ KeyFrameDecision Tracker::decide(const Frame& frame, int inliers) const {
   e.frame_tracked = static_cast<std::size_t>(inliers);
   const int min_obs = e.keyframes_in_map <= 2 ? 2 : 3;
   e.reference_tracked = static_cast<std::size_t>(reference_keyframe_->trackedPointCount(min_obs));
-  e.reference_points = static_cast<std::size_t>(reference_keyframe_->trackedPointCount(1));
   e.mapper_accepts = sink_ == nullptr || sink_->acceptsKeyFrames();
   e.mapper_accepts_urgent = sink_ == nullptr || sink_->acceptsUrgentKeyFrames();
   e.map_updates_paused = sink_ != nullptr && sink_->mapUpdatesPaused();
+  // Only read while paused: not worth a pass over the reference's points on every frame.
+  if (e.map_updates_paused) {
+    e.reference_points = static_cast<std::size_t>(reference_keyframe_->trackedPointCount(1));
+  }
   const KeyFrameDecision decision = decideKeyFrame(options_.keyframes, e);
   spdlog::debug(
       "frame {}: keyframe decision {} (since kf {}, since map update {}, kfs {}, features {}/{}, "

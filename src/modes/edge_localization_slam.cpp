@@ -25,6 +25,12 @@ EdgeLocalizationSlam::EdgeLocalizationSlam(const PinholeCamera& camera, SlamOpti
     : TrackingSlam(camera, localizationOptions(std::move(options)), link->idOrigin()),
       link_(std::move(link)) {
   link_->setSliceHandler([this](MapSlice slice) { onSlice(std::move(slice)); });
+  // A question the link gave up on is never answered: without this the client would wait for it
+  // and never ask again.
+  link_->setUploadDroppedHandler([this](std::uint64_t sequence, KeyFrameId /*keyframe*/) {
+    MutexLock lock(mutex_);
+    answered_ = std::max(answered_, sequence);
+  });
   startTracking(nullptr);
   tracker_->localizeInArrivingMap();
 }
