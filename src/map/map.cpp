@@ -255,6 +255,28 @@ void Map::eraseKeyFrame(KeyFrame* keyframe) {
   if (!node.empty()) retire(std::move(node.mapped()));
 }
 
+void Map::hangTreeFrom(KeyFrame* keyframe, KeyFrame* parent) {
+  // The path to the old root, each link turned round from the root down.
+  std::vector<KeyFrame*> path{keyframe};
+  while (path.back()->parent_ != nullptr && path.size() <= keyframes_.size()) {
+    path.push_back(path.back()->parent_);
+  }
+  for (std::size_t i = path.size() - 1; i > 0; --i) {
+    KeyFrame* upper = path[i];
+    KeyFrame* lower = path[i - 1];
+    upper->children_.erase(lower);
+    lower->parent_ = nullptr;
+    upper->parent_ = lower;
+    lower->children_.insert(upper);
+    upper->first_connection_ = false;
+    record().keyFrameUpdated(upper->id());
+  }
+  keyframe->parent_ = parent;
+  keyframe->first_connection_ = false;
+  parent->children_.insert(keyframe);
+  record().keyFrameUpdated(keyframe->id());
+}
+
 void Map::addLoopEdge(KeyFrame* a, KeyFrame* b) {
   a->loop_edges_.insert(b);
   b->loop_edges_.insert(a);

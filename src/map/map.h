@@ -89,6 +89,10 @@ class Map {
   // children.
   void eraseKeyFrame(KeyFrame* keyframe) REQUIRES(update_mutex_);
   void addLoopEdge(KeyFrame* a, KeyFrame* b) REQUIRES(update_mutex_);
+  // Joins two spanning trees (two parts of the map merged): `keyframe` becomes the root of its
+  // own tree (the links on its way to the old root turn round), then a child of `parent`, which
+  // must be in another tree. The keyframes whose parent changed are recorded as updated.
+  void hangTreeFrom(KeyFrame* keyframe, KeyFrame* parent) REQUIRES(update_mutex_);
   // A replica bounding what it holds: the keyframe keeps its id, pose and spanning-tree links (so
   // poses relative to it still follow corrections) but drops its features, its observations and
   // its covisibility links; points left without any observation are erased. No-op when bad or

@@ -181,9 +181,14 @@ void LocalMapper::linkKeyFrame(KeyFrame* keyframe) {
 }
 
 void LocalMapper::observeRecentPoints(KeyFrame* keyframe) {
+  // Only the keyframe's own client's: another client's recent points may be in another part of
+  // the map, in another frame, where a projection matches by chance.
   std::vector<MapPoint*> candidates;
   for (MapPoint* p : recent_points_) {
-    if (!p->isBad() && !p->observations().contains(keyframe->id())) candidates.push_back(p);
+    if (!p->isBad() && idOrigin(p->firstKeyFrameId()) == idOrigin(keyframe->id()) &&
+        !p->observations().contains(keyframe->id())) {
+      candidates.push_back(p);
+    }
   }
   if (candidates.empty()) return;
   const int observed = fuse(map_, keyframe, candidates, camera_);
@@ -203,6 +208,8 @@ void LocalMapper::cullRecentPoints(KeyFrame* keyframe) {
     const std::uint64_t age = (current & 0x00FFFFFFFFFFFFFF) - (born & 0x00FFFFFFFFFFFFFF);
     if (p->isBad()) {
       it = recent_points_.erase(it);
+    } else if (idOrigin(born) != idOrigin(current)) {
+      ++it;  // another client's: its age counts in that client's keyframes
     } else if (p->foundRatio() < 0.25f || (age >= 2 && p->observationCount() <= min_observations)) {
       map_.erasePoint(p);
       ++culled;
@@ -343,8 +350,11 @@ bool LocalMapper::cullRevisit(KeyFrame* keyframe) {
   const Eigen::Vector3d axis = keyframe->poseInverse().rotation() * Eigen::Vector3d::UnitZ();
   for (KeyFrame* older :
        keyframe->covisiblesWithWeightAtLeast(options_.revisit_min_shared_points)) {
-    if (older->isBad() ||
-        older->frameIndex() + options_.revisit_min_frames > keyframe->frameIndex()) {
+    // Another client's keyframe is a revisit whatever its frame number (each client counts its
+    // own frames).
+    const bool same_client = idOrigin(older->id()) == idOrigin(keyframe->id());
+    if (older->isBad() || (same_client && older->frameIndex() + options_.revisit_min_frames >
+                                              keyframe->frameIndex())) {
       continue;
     }
     if ((older->cameraCenter() - keyframe->cameraCenter()).norm() > max_distance) continue;

@@ -156,7 +156,7 @@ void LoopCloser::closeLoop(const VerifiedLoop& loop) {
   if (mapper_ != nullptr) mapper_->pause();
   LoopCorrectionResult corrected;
   try {
-    corrected = correctLoop(map_, loop, camera_, options_.correction);
+    corrected = correctLoop(map_, loop, camera_, options_.correction, on_merged_);
   } catch (...) {
     if (mapper_ != nullptr) mapper_->resume();
     throw;
@@ -183,6 +183,14 @@ void LoopCloser::closeLoop(const VerifiedLoop& loop) {
   event.rotation_deg = corrected.rotation_deg;
   event.correction_ms = elapsed_ms;
   event.pose_graph_ms = corrected.pose_graph_ms;
+  event.keyframes_merged = corrected.merged_keyframes_moved;
+  if (event.keyframes_merged > 0) {
+    spdlog::info(
+        "maps merged: keyframe {} (frame {}) -> keyframe {} (frame {}): {} keyframes and {} "
+        "points moved onto the other part of the map",
+        event.current, event.current_frame, event.loop, event.loop_frame,
+        corrected.merged_keyframes_moved, corrected.merged_points_moved);
+  }
   spdlog::info(
       "loop closed: keyframe {} (frame {}) -> keyframe {} (frame {}): {} Sim3 inliers, {} points "
       "matched, scale {:.3f}, moved {:.3f} m / {:.2f} deg; {} keyframes corrected with it, {} "

@@ -57,6 +57,9 @@ struct LoopEvent {
   double rotation_deg = 0.0;
   double correction_ms = 0.0;  // verification excluded: correction and essential graph
   double pose_graph_ms = 0.0;
+  // A loop that joined two parts of the map (two clients', or a session begun on a map of its
+  // own): the keyframes moved onto the other part first. 0 for an ordinary loop.
+  std::size_t keyframes_merged = 0;
 };
 
 struct LoopCloserStats {
@@ -100,6 +103,11 @@ class LoopCloser {
   void setMapCorrectedCallback(std::function<void()> callback) {
     on_corrected_ = std::move(callback);
   }
+  // Called when a loop merges two parts of the map, with the move one part made, at once: under
+  // the map's update mutex, which it must not take (set before start()).
+  void setPartsMergedCallback(std::function<void(const MapPartMerge&)> callback) {
+    on_merged_ = std::move(callback);
+  }
 
   std::size_t loops() const { return loops_.load(); }
   LoopCloserStats stats() const;
@@ -136,6 +144,7 @@ class LoopCloser {
   mutable Mutex stats_mutex_;
   LoopCloserStats stats_ GUARDED_BY(stats_mutex_);
   std::function<void()> on_corrected_;
+  std::function<void(const MapPartMerge&)> on_merged_;
   // Last: its thread, which uses everything above, ends before any of it is destroyed.
   QueuedWorker<KeyFrame*> queue_;
 };

@@ -7,6 +7,7 @@
 
 #include "map/map_matching.h"
 #include "mapping/loop_map_correction.h"
+#include "mapping/map_part_merge.h"
 #include "optimize/pose_graph.h"
 #include "util/timing_stats.h"
 
@@ -31,9 +32,11 @@ struct GraphSnapshot {
 
 }  // namespace
 
-LoopCorrectionResult correctLoop(Map& map, const VerifiedLoop& loop, const PinholeCamera& camera,
-                                 const LoopCorrectionOptions& options) {
+LoopCorrectionResult correctLoop(Map& map, const VerifiedLoop& verified,
+                                 const PinholeCamera& camera, const LoopCorrectionOptions& options,
+                                 const std::function<void(const MapPartMerge&)>& on_merged) {
   LoopCorrectionResult result;
+  VerifiedLoop loop = verified;  // a merge of two parts re-expresses S_cw
   KeyFrame* current = loop.current;
   KeyFrame* loop_kf = loop.loop;
   GraphSnapshot snapshot;
@@ -41,6 +44,11 @@ LoopCorrectionResult correctLoop(Map& map, const VerifiedLoop& loop, const Pinho
   {
     MutexLock lock(map.updateMutex());
     if (current->isBad() || loop_kf->isBad()) return result;
+    // 0. Two parts of the map that shared nothing: one is moved onto the other first.
+    result.merge = mergeSeparateParts(map, loop);
+    result.merged_keyframes_moved = result.merge.keyframes_moved;
+    result.merged_points_moved = result.merge.points_moved;
+    if (result.merge.merged && on_merged) on_merged(result.merge);
     current_before = current->pose();
     map.updateConnections(current);
 

@@ -6,10 +6,12 @@
 // whole map (optimize/pose_graph.h). Takes the map's update mutex itself; the graph is solved
 // without it, and keyframes made meanwhile follow their spanning-tree parents.
 #include <cstddef>
+#include <functional>
 
 #include "geometry/camera.h"
 #include "map/map.h"
 #include "mapping/loop_verifier.h"
+#include "mapping/map_part_merge.h"
 
 namespace edgeslam {
 
@@ -32,9 +34,18 @@ struct LoopCorrectionResult {
   double rotation_deg = 0.0;
   double scale = 1.0;
   double pose_graph_ms = 0.0;
+  // A loop between two parts of the map that shared nothing (mergeSeparateParts): how much of
+  // the map was moved onto the other part before the correction. 0 for an ordinary loop.
+  std::size_t merged_keyframes_moved = 0;
+  std::size_t merged_points_moved = 0;
+  MapPartMerge merge;
 };
 
+// `on_merged` is told of a merge of two parts (mergeSeparateParts) as soon as it is made, under
+// the map's update mutex (it must not take it): keyframes inserted after that are the caller's.
 LoopCorrectionResult correctLoop(Map& map, const VerifiedLoop& loop, const PinholeCamera& camera,
-                                 const LoopCorrectionOptions& options) EXCLUDES(map.updateMutex());
+                                 const LoopCorrectionOptions& options,
+                                 const std::function<void(const MapPartMerge&)>& on_merged = {})
+    EXCLUDES(map.updateMutex());
 
 }  // namespace edgeslam

@@ -10,9 +10,7 @@ namespace edgeslam {
 
 LoopDetector::LoopDetector(std::shared_ptr<const Vocabulary> vocabulary,
                            LoopDetectorOptions options)
-    : vocabulary_(std::move(vocabulary)),
-      options_(options),
-      consistency_(options.consistency_required) {
+    : vocabulary_(std::move(vocabulary)), options_(options) {
   if (vocabulary_ == nullptr || vocabulary_->empty()) {
     throw std::invalid_argument("LoopDetector: a non-empty vocabulary is required");
   }
@@ -47,7 +45,7 @@ void LoopDetector::clear() {
   MutexLock lock(bow_mutex_);
   bows_.clear();
   database_.clear();
-  consistency_.reset();
+  consistency_.clear();
 }
 
 std::size_t LoopDetector::forgetIf(const std::function<bool(KeyFrameId)>& gone) {
@@ -117,7 +115,10 @@ LoopDetection LoopDetector::detect(KeyFrame* keyframe, const Map& map, bool sear
       for (const auto& [kf, weight] : candidate->connections()) group.members.push_back(kf->id());
       groups.push_back(std::move(group));
     }
-    for (const std::uint64_t id : consistency_.update(groups)) {
+    LoopConsistency& consistency =
+        consistency_.try_emplace(idOrigin(keyframe->id()), options_.consistency_required)
+            .first->second;
+    for (const std::uint64_t id : consistency.update(groups)) {
       if (KeyFrame* kf = map.keyFrame(id); kf != nullptr && !kf->isBad()) {
         out.candidates.push_back(kf);
       }

@@ -7,6 +7,7 @@
 // consistent (loop_consistency.h) before they are handed on to geometric verification.
 #include <cstddef>
 #include <functional>
+#include <map>
 #include <memory>
 #include <unordered_map>
 #include <vector>
@@ -64,7 +65,7 @@ class LoopDetector {
       REQUIRES(map.updateMutex());
 
   // Forgets the consistency history (after a loop has been closed or the map reset).
-  void resetConsistency() { consistency_.reset(); }
+  void resetConsistency() { consistency_.clear(); }
   // Drops everything (map reset).
   void clear();
   // Forgets the keyframes `gone` says the map no longer has: their bags of words and database
@@ -84,7 +85,9 @@ class LoopDetector {
   mutable Mutex bow_mutex_;
   std::unordered_map<KeyFrameId, KeyFrameBow> bows_ GUARDED_BY(bow_mutex_);
   KeyFrameDatabase database_;
-  LoopConsistency consistency_;
+  // One history per client (by the keyframes' id origin): consistency is over one camera's
+  // consecutive keyframes, and several clients' keyframes come interleaved into one map.
+  std::map<std::uint8_t, LoopConsistency> consistency_;
 };
 
 }  // namespace edgeslam

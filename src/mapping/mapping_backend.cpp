@@ -131,6 +131,7 @@ MappingBackend::MappingBackend(Map& map, const PinholeCamera& camera, Sensor sen
     loop_closer_ =
         std::make_unique<LoopCloser>(map_, camera, options.vocabulary, loop, mapper_.get());
     if (hooks_.map_corrected) loop_closer_->setMapCorrectedCallback(hooks_.map_corrected);
+    if (hooks_.parts_merged) loop_closer_->setPartsMergedCallback(hooks_.parts_merged);
   }
   if (hooks_.keyframe_mapped || loop_closer_) {
     mapper_->setKeyFrameMappedCallback([this](KeyFrame* keyframe) {

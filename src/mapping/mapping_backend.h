@@ -62,6 +62,9 @@ struct MappingBackendHooks {
   std::function<void(KeyFrame*)> keyframe_mapped;
   // After each loop correction and each applied global bundle adjustment.
   std::function<void()> map_corrected;
+  // When a loop merges two parts of the map: the move one part made, told under the map's update
+  // mutex (the hook must not take it), before the rest of the correction and map_corrected.
+  std::function<void(const MapPartMerge&)> parts_merged;
   // After a keyframe's segmentation, once its movable points are erased (the keyframe may have
   // been culled meanwhile: the labels are still worth having).
   std::function<void(KeyFrameSegmentationResult)> keyframe_segmented;

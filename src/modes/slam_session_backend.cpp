@@ -53,8 +53,9 @@ MapSample sampleOf(const Map& map, std::size_t max_points) {
 }  // namespace
 
 SlamSessionBackend::SlamSessionBackend(const SessionConfig& config, SliceSink& sink,
-                                       SlamSessionOptions options)
-    : config_(config), sink_(sink), options_(options) {
+                                       SlamSessionOptions options,
+                                       std::shared_ptr<LiveEdgeMaps> live_maps)
+    : config_(config), sink_(sink), options_(options), live_maps_(std::move(live_maps)) {
   if (config_.settings.semantic && options_.segmenter) {
     try {
       segmenter_ = makeSegmenter(*options_.segmenter);
@@ -67,14 +68,42 @@ SlamSessionBackend::SlamSessionBackend(const SessionConfig& config, SliceSink& s
     makeLocalization();
     return;
   }
-  // A session naming a map the store holds resumes it (a client reconnecting after a restart):
-  // loaded now, so that the full resync the client asks for first carries it.
-  if (auto resumed = storedSessionToResume()) makeMapping(std::move(resumed));
+  // A session naming a map another client writes now joins it. One naming a map the store holds
+  // resumes it (a client reconnecting after a restart): loaded now, so that the full resync the
+  // client asks for first carries it.
+  if (live_maps_ && !config_.map_name.empty()) {
+    bool joined = false;
+    std::shared_ptr<LiveEdgeMap> live = live_maps_->findOrMake(
+        config_.map_name, [&] { return makeMapping(storedSessionToResume()); }, joined);
+    if (joined) joinMapping(std::move(live));
+    return;
+  }
+  if (auto resumed = storedSessionToResume()) mapping_ = makeMapping(std::move(resumed));
+}
+
+void SlamSessionBackend::joinMapping(std::shared_ptr<LiveEdgeMap> live) {
+  if (std::optional<std::string> why = whyCannotJoin(live->made_by, config_)) {
+    throw std::invalid_argument(
+        fmt::format("map '{}' is being written by another client, and this one cannot join it: {}",
+                    config_.map_name, *why));
+  }
+  MutexLock view_lock(view_mutex_);
+  ClientMapWindowOptions window = options_.mapping.window;
+  window.keyframes = static_cast<std::size_t>(config_.settings.client_map_keyframes);
+  client_ = live->session->addClient(window, [this](MapSlice slice) { publish(std::move(slice)); });
+  // Ids of this origin the map holds (a client that had it before): this client's start above.
+  id_floor_ = live->session->largestIdOfOrigin(config_.id_origin);
+  mapping_ = std::move(live);
+  spdlog::info("session {}: joins map '{}', written by {} other client(s) of this server",
+               config_.session_id, config_.map_name, mapping_->session->clientCount() - 1);
 }
 
 SlamSessionBackend::~SlamSessionBackend() {
-  if (mapping_) mapping_->stop();
-  if (store_writer_) store_writer_->stop();
+  if (mapping_) {
+    // The map goes on while another client writes it; no slice reaches this session once out.
+    mapping_->session->removeClient(client_);
+    mapping_.reset();
+  }
   if (slices_split_.load() + slices_not_sent_.load() > 0) {
     spdlog::info("session {}: {} slices split to fit a message, {} not sent", config_.session_id,
                  slices_split_.load(), slices_not_sent_.load());
@@ -123,8 +152,10 @@ void SlamSessionBackend::publish(MapSlice slice) {
   }
 }
 
-void SlamSessionBackend::makeMapping(std::optional<StoredSession> resumed) {
+std::shared_ptr<LiveEdgeMap> SlamSessionBackend::makeMapping(std::optional<StoredSession> resumed) {
   MutexLock view_lock(view_mutex_);
+  auto live = std::make_shared<LiveEdgeMap>();
+  live->made_by = config_;
   EdgeMapSessionOptions mapping = options_.mapping;
   mapping.backend.mapper.observe_recent_points = true;
   mapping.backend.segmenter = segmenter_;
@@ -165,11 +196,13 @@ void SlamSessionBackend::makeMapping(std::optional<StoredSession> resumed) {
       rebuild_ms = timer.elapsedMs();
     };
   }
-  mapping_ =
+  live->session =
       std::make_unique<EdgeMapSession>(config_.camera, config_.sensor, mapping,
                                        [this](MapSlice slice) { publish(std::move(slice)); });
+  mapping_ = live;
+  client_ = 0;
   if (resumed) {
-    const EdgeMapSessionStats loaded = mapping_->stats();
+    const EdgeMapSessionStats loaded = live->session->stats();
     const std::size_t keyframes = std::max<std::size_t>(1, loaded.keyframes_loaded);
     spdlog::info(
         "session {}: map '{}' resumed: {} keyframes, {} points; rebuilt in {:.0f} ms, bags of "
@@ -178,8 +211,9 @@ void SlamSessionBackend::makeMapping(std::optional<StoredSession> resumed) {
         rebuild_ms, loaded.load_describe_ms, places_attached, places_missing.size(),
         (rebuild_ms + loaded.load_describe_ms) / static_cast<double>(keyframes));
   }
-  startStoreWriter(resumed ? std::optional<StoreSessionId>(resumed->id) : std::nullopt,
+  startStoreWriter(*live, resumed ? std::optional<StoreSessionId>(resumed->id) : std::nullopt,
                    stored_keyframes, places_missing);
+  return live;
 }
 
 void SlamSessionBackend::makeLocalization() {
@@ -247,7 +281,7 @@ void SlamSessionBackend::onKeyFrame(KeyFrameUpload upload) {
     throw std::invalid_argument("a localisation query in a session that maps (not localize-only)");
   }
   if (!mapping_) makeMapping(std::nullopt);
-  mapping_->onKeyFrame(upload);
+  mapping().onKeyFrame(upload, client_);
 }
 
 void SlamSessionBackend::onFullResyncRequested() {
@@ -258,10 +292,10 @@ void SlamSessionBackend::onFullResyncRequested() {
   // A session with nothing mapped yet (no stored map to resume) answers with an empty map: the
   // client then sends again every keyframe it holds.
   if (!mapping_) makeMapping(std::nullopt);
-  mapping_->publishFullResync();
+  mapping().publishFullResync(client_);
 }
 
-void SlamSessionBackend::startStoreWriter(std::optional<StoreSessionId> resumed,
+void SlamSessionBackend::startStoreWriter(LiveEdgeMap& live, std::optional<StoreSessionId> resumed,
                                           const std::vector<KeyFrameId>& stored_keyframes,
                                           const std::vector<KeyFrameId>& places_missing) {
   if (!options_.store) return;
@@ -278,11 +312,11 @@ void SlamSessionBackend::startStoreWriter(std::optional<StoreSessionId> resumed,
       session =
           options_.store->beginSession(map, {config_.client_name, config_.camera, config_.sensor});
     }
-    store_writer_ = std::make_unique<MapStoreWriter>(options_.store, session, mapping_->map(),
-                                                     options_.store_stats);
-    store_writer_->assumeStored(stored_keyframes);
-    store_writer_->storePlacesOf(places_missing);
-    mapping_->setChangeObserver(store_writer_.get());
+    live.store_writer = std::make_unique<MapStoreWriter>(options_.store, session,
+                                                         live.session->map(), options_.store_stats);
+    live.store_writer->assumeStored(stored_keyframes);
+    live.store_writer->storePlacesOf(places_missing);
+    live.session->setChangeObserver(live.store_writer.get());
     spdlog::info("session {}: writing map '{}' to {}{}", config_.session_id, map,
                  options_.store->location(), resumed ? " (resumed)" : "");
   } catch (const std::exception& e) {
@@ -326,7 +360,7 @@ std::optional<OffloadResult> SlamSessionBackend::onFrame(OffloadFrame frame) {
 std::optional<std::string> SlamSessionBackend::failure() const {
   MutexLock view_lock(view_mutex_);
   if (offload_) return offload_->failure();
-  if (mapping_) return mapping_->failure();
+  if (mapping_) return mapping().failure();
   return std::nullopt;
 }
 
@@ -334,13 +368,13 @@ MapSample SlamSessionBackend::mapSample(std::size_t max_points) const {
   MutexLock view_lock(view_mutex_);
   if (offload_) return offload_->mapSample(max_points);
   if (localization_) return sampleOf(localization_->map(), max_points);
-  if (mapping_) return sampleOf(mapping_->map(), max_points);
+  if (mapping_) return sampleOf(mapping().map(), max_points);
   return {};
 }
 
 std::size_t SlamSessionBackend::loops() const {
   MutexLock view_lock(view_mutex_);
-  if (mapping_ && mapping_->loopCloser() != nullptr) return mapping_->loopCloser()->loops();
+  if (mapping_ && mapping().loopCloser() != nullptr) return mapping().loopCloser()->loops();
   return 0;
 }
 
@@ -357,7 +391,7 @@ std::unique_ptr<EdgeSessionBackend> SlamSessionFactory::open(const SessionConfig
   if (!config.map_name.empty()) checkMapName(config.map_name);
   spdlog::info("edge: session {} for '{}' ({}x{}, {})", config.session_id, config.client_name,
                config.camera.width(), config.camera.height(), toString(config.sensor));
-  return std::make_unique<SlamSessionBackend>(config, sink, options_);
+  return std::make_unique<SlamSessionBackend>(config, sink, options_, live_maps_);
 }
 
 }  // namespace edgeslam

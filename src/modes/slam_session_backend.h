@@ -5,6 +5,7 @@
 #include <memory>
 #include <optional>
 
+#include "modes/live_edge_maps.h"
 #include "modes/local_slam.h"
 #include "modes/slam_system.h"
 #include "server/edge_localization_session.h"
@@ -28,7 +29,10 @@ struct SlamSessionOptions {
 
 class SlamSessionBackend : public EdgeSessionBackend {
  public:
-  SlamSessionBackend(const SessionConfig& config, SliceSink& sink, SlamSessionOptions options);
+  // `live_maps`: the maps the server's other sessions write now; a session naming one of them
+  // joins it (nullptr: each session has a map of its own).
+  SlamSessionBackend(const SessionConfig& config, SliceSink& sink, SlamSessionOptions options,
+                     std::shared_ptr<LiveEdgeMaps> live_maps = nullptr);
   ~SlamSessionBackend() override;
 
   void onKeyFrame(KeyFrameUpload upload) override;
@@ -48,11 +52,15 @@ class SlamSessionBackend : public EdgeSessionBackend {
  private:
   // The map's latest stored session with keyframes, when the session names a stored map.
   std::optional<StoredSession> storedSessionToResume();
-  void makeMapping(std::optional<StoredSession> resumed);
+  std::shared_ptr<LiveEdgeMap> makeMapping(std::optional<StoredSession> resumed);
+  // Writes into the map another session of the server is writing. Throws std::invalid_argument
+  // when this client cannot (whyCannotJoin).
+  void joinMapping(std::shared_ptr<LiveEdgeMap> live);
+  EdgeMapSession& mapping() const { return *mapping_->session; }
   // A localise-only session: the stored map it names, read-only. Throws std::invalid_argument when
   // the edge cannot serve it (no store, no such map, another sensor, no vocabulary).
   void makeLocalization();
-  void startStoreWriter(std::optional<StoreSessionId> resumed,
+  void startStoreWriter(LiveEdgeMap& live, std::optional<StoreSessionId> resumed,
                         const std::vector<KeyFrameId>& stored_keyframes,
                         const std::vector<KeyFrameId>& places_missing);
   void publish(MapSlice slice);
@@ -63,9 +71,12 @@ class SlamSessionBackend : public EdgeSessionBackend {
   SessionConfig config_;
   SliceSink& sink_;
   SlamSessionOptions options_;
-  std::shared_ptr<Segmenter> segmenter_;          // when the session asked for semantic culling
-  std::unique_ptr<MapStoreWriter> store_writer_;  // outlives mapping_, which it observes
-  std::unique_ptr<EdgeMapSession> mapping_;       // edge mode, made at the first keyframe
+  std::shared_ptr<Segmenter> segmenter_;  // when the session asked for semantic culling
+  std::shared_ptr<LiveEdgeMaps> live_maps_;
+  // Edge mode: the map, made when the session opens (a named map) or at the first keyframe; shared
+  // with the other sessions writing the same named map.
+  std::shared_ptr<LiveEdgeMap> mapping_;
+  EdgeMapClientId client_ = 0;                             // this session's client in mapping_
   std::unique_ptr<EdgeLocalizationSession> localization_;  // localise-only edge sessions
   std::unique_ptr<LocalSlam> offload_;                     // offload mode, made at the first frame
   std::uint64_t id_floor_ = 0;
@@ -75,11 +86,13 @@ class SlamSessionBackend : public EdgeSessionBackend {
 
 class SlamSessionFactory : public EdgeSessionFactory {
  public:
-  explicit SlamSessionFactory(SlamSessionOptions options = {}) : options_(options) {}
+  explicit SlamSessionFactory(SlamSessionOptions options = {})
+      : options_(options), live_maps_(std::make_shared<LiveEdgeMaps>()) {}
   std::unique_ptr<EdgeSessionBackend> open(const SessionConfig& config, SliceSink& sink) override;
 
  private:
   SlamSessionOptions options_;
+  std::shared_ptr<LiveEdgeMaps> live_maps_;
 };
 
 }  // namespace edgeslam

@@ -18,6 +18,43 @@ std::optional<double> rightU(const FrameFeatures& features, std::size_t i) {
   return features.right_u[i];
 }
 
+// Keyframes linked by the points they share form parts; a part with no fixed keyframe (another
+// client's part of a shared map before a loop joins it to the origin's, or a window away from
+// every fixed keyframe) would float: its oldest keyframe holds it.
+void fixGaugeOfFloatingParts(BundleAdjustmentProblem& problem) {
+  const std::size_t n = problem.keyframes.size();
+  std::vector<std::size_t> root(n);
+  for (std::size_t k = 0; k < n; ++k) root[k] = k;
+  const auto find = [&](std::size_t k) {
+    while (root[k] != k) k = root[k] = root[root[k]];
+    return k;
+  };
+  std::vector<std::size_t> first_observer(problem.points.size(), n);
+  for (const auto& obs : problem.observations) {
+    std::size_t& first = first_observer[obs.point];
+    if (first == n) {
+      first = obs.keyframe;
+    } else {
+      root[find(obs.keyframe)] = find(first);
+    }
+  }
+  std::vector<bool> held(n, false);
+  for (std::size_t k = 0; k < n; ++k) {
+    if (problem.keyframes[k].fixed) held[find(k)] = true;
+  }
+  std::vector<std::size_t> oldest(n, n);
+  for (std::size_t k = 0; k < n; ++k) {
+    const std::size_t part = find(k);
+    if (held[part]) continue;
+    if (oldest[part] == n || problem.keyframes[k].id < problem.keyframes[oldest[part]].id) {
+      oldest[part] = k;
+    }
+  }
+  for (std::size_t part = 0; part < n; ++part) {
+    if (oldest[part] != n) problem.keyframes[oldest[part]].fixed = true;
+  }
+}
+
 // Builds the problem for the given free keyframes; returns false when there is nothing to optimise.
 struct ProblemBuild {
   BundleAdjustmentProblem problem;
@@ -61,6 +98,7 @@ ProblemBuild buildProblem(const std::vector<KeyFrame*>& free_keyframes, KeyFrame
       build.observation_owners.emplace_back(kf, p);
     }
   }
+  fixGaugeOfFloatingParts(build.problem);
   if (!build.keyframes.empty()) {
     build.problem.camera = projectionFor(camera, build.keyframes.front()->features());
   }

@@ -20,8 +20,10 @@ std::vector<KeyFrame*> keyFrameNeighbourhood(const Map& map, KeyFrame* centre, s
   if (recent > 0) {
     const std::vector<KeyFrame*> all = map.keyFrames();  // by id: the newest last
     std::size_t taken = 0;
+    // The centre's own client's: in a map several clients write, the others' newest keyframes
+    // are far away (their ids have another top byte).
     for (auto it = all.rbegin(); it != all.rend() && taken < recent; ++it) {
-      if ((*it)->isBad()) continue;
+      if ((*it)->isBad() || idOrigin((*it)->id()) != idOrigin(centre->id())) continue;
       choose(*it);
       ++taken;
     }

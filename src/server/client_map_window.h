@@ -27,7 +27,8 @@ struct ClientMapWindowOptions {
   std::size_t max_entering_per_slice = 10;
 };
 
-// Up to `count` keyframes around `centre`: the centre, the `recent` highest ids (most recent), then
+// Up to `count` keyframes around `centre`: the centre, the `recent` highest ids of the centre's
+// origin (its client's most recent), then
 // their covisibility neighbourhood breadth first, each keyframe's links strongest first.
 // Deterministic, and a shorter list is a prefix of a longer one.
 std::vector<KeyFrame*> keyFrameNeighbourhood(const Map& map, KeyFrame* centre, std::size_t count,

@@ -22,16 +22,20 @@ MappingBackendOptions edgeSessionBackendOptions() {
 
 EdgeMapSession::EdgeMapSession(const PinholeCamera& camera, Sensor sensor,
                                EdgeMapSessionOptions options, Publish publish)
-    : camera_(camera),
-      mask_downscale_(std::max(1, options.mask_downscale)),
-      publish_(std::move(publish)),
-      window_(options.window) {
+    : camera_(camera), mask_downscale_(std::max(1, options.mask_downscale)) {
+  {
+    MutexLock lock(map_.updateMutex());
+    first_client_ =
+        clients_.emplace(0, std::make_unique<Client>(options.window, std::move(publish)))
+            .first->second.get();
+  }
   MappingBackendHooks hooks;
   hooks.keyframe_mapped = [this](KeyFrame* keyframe) { publishSlice(keyframe); };
   hooks.map_corrected = [this] { publishSlice(nullptr); };
   hooks.keyframe_segmented = [this](KeyFrameSegmentationResult result) {
     onSegmented(std::move(result));
   };
+  hooks.parts_merged = [this](const MapPartMerge& merge) { onPartsMerged(merge); };
   backend_ = std::make_unique<MappingBackend>(map_, camera_, sensor, std::move(options.backend),
                                               std::move(hooks));
   if (options.preload) options.preload(map_);
@@ -44,19 +48,20 @@ void EdgeMapSession::adoptPreloadedMap() {
   KeyFrameId newest = kInvalidId;
   {
     MutexLock lock(map_.updateMutex());
+    Client& first = clientLocked(0);
     for (KeyFrame* keyframe : map_.keyFrames()) {
       if (keyframe->isBad()) continue;
       loaded.push_back(keyframe);
-      window_.clientHolds(keyframe->id());
+      first.window.clientHolds(keyframe->id());
       newest = std::max(newest, keyframe->id());
     }
+    if (!loaded.empty()) first.newest_keyframe = newest;
   }
   if (loaded.empty()) return;
   // Before the threads start: nothing else touches the keyframes' places or the loop database.
   Stopwatch timer;
   backend_->adoptLoadedKeyFrames(loaded);
   MutexLock state(state_mutex_);
-  newest_keyframe_ = newest;
   stats_.keyframes_loaded = loaded.size();
   stats_.load_describe_ms = timer.elapsedMs();
   stats_.keyframes = loaded.size();
@@ -77,7 +82,52 @@ void EdgeMapSession::stop() {
   backend_->stop();
 }
 
-void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
+EdgeMapSession::Client& EdgeMapSession::clientLocked(EdgeMapClientId client) const {
+  const auto it = clients_.find(client);
+  if (it == clients_.end()) {
+    throw std::invalid_argument("client " + std::to_string(client) + " is not in the session");
+  }
+  return *it->second;
+}
+
+EdgeMapClientId EdgeMapSession::addClient(ClientMapWindowOptions window, Publish publish) {
+  if (window.keyframes == 0) {
+    throw std::invalid_argument(
+        "a client joining a map other clients write needs a bounded map (client map keyframes "
+        "> 0): it learns of their keyframes as they enter its window");
+  }
+  MutexLock publishing(publish_mutex_);
+  MutexLock lock(map_.updateMutex());
+  const EdgeMapClientId id = next_client_++;
+  clients_.emplace(id, std::make_unique<Client>(window, std::move(publish)));
+  return id;
+}
+
+void EdgeMapSession::removeClient(EdgeMapClientId client) {
+  MutexLock publishing(publish_mutex_);
+  MutexLock lock(map_.updateMutex());
+  if (client == 0) first_client_ = nullptr;
+  clients_.erase(client);
+}
+
+std::size_t EdgeMapSession::clientCount() const {
+  MutexLock lock(map_.updateMutex());
+  return clients_.size();
+}
+
+std::uint64_t EdgeMapSession::largestIdOfOrigin(std::uint8_t origin) const {
+  MutexLock lock(map_.updateMutex());
+  std::uint64_t largest = 0;
+  for (const KeyFrame* keyframe : map_.keyFrames()) {
+    if (idOrigin(keyframe->id()) == origin) largest = std::max(largest, keyframe->id());
+  }
+  for (const MapPoint* point : map_.mapPoints()) {
+    if (idOrigin(point->id()) == origin) largest = std::max(largest, point->id());
+  }
+  return largest;
+}
+
+void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload, EdgeMapClientId client_id) {
   cv::Mat image;
   if (backend_->segments() && !upload.image_bytes.empty()) {
     image = cv::imdecode(upload.image_bytes, cv::IMREAD_UNCHANGED);
@@ -90,6 +140,7 @@ void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
   KeyFrame* keyframe = nullptr;
   {
     MutexLock lock(map_.updateMutex());
+    Client& client = clientLocked(client_id);
     if (!upload.map_reset && map_.keyFrame(upload.keyframe.id) != nullptr) {
       // Re-sent after a full resync while its first upload was still on its way, or sent to a
       // server that stored it before a restart: the map has it. The client waits for an answer.
@@ -98,15 +149,22 @@ void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
         MutexLock state(state_mutex_);
         ++stats_.uploads_duplicate;
       }
-      publishSlice(nullptr, upload.sequence);
+      publishSlice(nullptr, upload.sequence, client_id);
       return;
     }
     if (upload.map_reset) {
-      backend_->onMapReset();
-      map_.clear();
-      if (observer_ != nullptr) observer_->onMapCleared();
-      window_.clear();
-      window_centre_ = kInvalidId;
+      if (clients_.size() == 1) {
+        backend_->onMapReset();
+        map_.clear();
+        if (observer_ != nullptr) observer_->onMapCleared();
+      } else {
+        // The others' keyframes stay; the client's old ones stay in the map, in their own part.
+        spdlog::warn(
+            "edge map: a client started its map again; the map others write keeps what "
+            "it had made");
+      }
+      client.window.clear();
+      client.window_centre = kInvalidId;
     }
     // Descriptors the wire left out are those of points this map has (or had).
     const KeyFrameRecord* record = &upload.keyframe;
@@ -123,11 +181,22 @@ void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
             filled.id, fill.lost.size(), fill.lost.front());
       }
     }
+    std::vector<MapPointRecord> new_points = upload.new_points;
+    KeyFrameRecord moved;
+    if (const std::optional<Sim3d> world = partMoveMissedBy(*record)) {
+      moved = *record;
+      moved.T_cw = (Sim3d(moved.T_cw) * world->inverse()).toSE3();
+      for (MapPointRecord& point : new_points) point.position = *world * point.position;
+      record = &moved;
+      spdlog::info(
+          "edge map: keyframe {:#x} was tracked before its client heard of a merge: "
+          "moved with its part",
+          moved.id);
+    }
     // The client already has what it sent: apply it without recording it for the slices.
     map_.setChangeRecording(false);
     std::vector<UploadedPointConflict> conflicts;
     try {
-      std::vector<MapPointRecord> new_points = upload.new_points;
       rebuildPositionsFromDepth(new_points, *record, camera_);
       keyframe = insertKeyFrameRecord(map_, *record, camera_);
       for (const MapPointRecord& point : new_points) {
@@ -154,13 +223,13 @@ void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
       }
       observer_->onMapChanged(uploaded);
     }
-    window_.clientHolds(keyframe->id());
+    client.window.clientHolds(keyframe->id());
+    client.upload_of_keyframe[keyframe->id()] = upload.sequence;
+    client.newest_keyframe = keyframe->id();
     MutexLock state(state_mutex_);
     ++stats_.uploads;
     stats_.descriptors_filled += fill.filled;
     stats_.descriptors_lost += fill.lost.size();
-    upload_of_keyframe_[keyframe->id()] = upload.sequence;
-    newest_keyframe_ = keyframe->id();
   }
   if (upload.segmenter_nms > 0.f) backend_->setNmsThreshold(upload.segmenter_nms);
   if (!image.empty()) {
@@ -171,9 +240,10 @@ void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload) {
   backend_->processAll();
 }
 
-void EdgeMapSession::publishSlice(KeyFrame* mapped, std::uint64_t answers) {
+void EdgeMapSession::publishSlice(KeyFrame* mapped, std::uint64_t answers,
+                                  EdgeMapClientId answered) {
   MutexLock publishing(publish_mutex_);
-  MapSlice slice;
+  std::vector<std::pair<const Publish*, MapSlice>> outgoing;
   {
     MutexLock lock(map_.updateMutex());
     const std::size_t loops = backend_->loops();
@@ -182,7 +252,10 @@ void EdgeMapSession::publishSlice(KeyFrame* mapped, std::uint64_t answers) {
       MutexLock state(state_mutex_);
       masks.swap(pending_masks_);
     }
-    if (mapped == nullptr && answers == 0 && map_.changes().empty() && loops == loops_published_ &&
+    const bool loops_unpublished =
+        std::any_of(clients_.begin(), clients_.end(),
+                    [&](const auto& c) { return c.second->loops_published != loops; });
+    if (mapped == nullptr && answers == 0 && map_.changes().empty() && !loops_unpublished &&
         masks.empty()) {
       return;
     }
@@ -191,60 +264,114 @@ void EdgeMapSession::publishSlice(KeyFrame* mapped, std::uint64_t answers) {
       observer_->onMapChanged(changes);
       if (!masks.empty()) observer_->onMasks(masks);
     }
-    slice = buildSlice(map_, changes);
-    // A keyframe culled as soon as it was mapped (a revisit) hands the window to the keyframe it
-    // hangs from in the spanning tree, near where the camera is.
-    KeyFrame* centre = mapped;
-    while (centre != nullptr && centre->isBad()) centre = centre->parent();
-    if (centre != nullptr) window_centre_ = centre->id();
-    // Loop corrections and global BA keep the window of the last mapped keyframe.
-    const std::size_t entering_before = slice.keyframes.size();
-    window_.shape(map_, map_.keyFrame(window_centre_), slice);
-    slice.map_keyframes = map_.keyFrameCount();
-    slice.map_points = map_.pointCount();
-    slice.masks = std::move(masks);
-    if (mapped != nullptr) {
-      slice.processed_keyframe = mapped->id();
-      if (!mapped->isBad()) {
-        slice.reference_keyframe = mapped->id();
-        slice.reference_pose = mapped->pose();
-      }
+    const MapSlice common = buildSlice(map_, changes);
+    for (auto& [id, client] : clients_) {
+      // A client alone had every keyframe mapped for it (one loaded, or uploaded before a reset).
+      const bool mapped_for_client =
+          mapped != nullptr &&
+          (clients_.size() == 1 || client->upload_of_keyframe.contains(mapped->id()));
+      const bool answers_client = mapped_for_client || (answers != 0 && id == answered);
+      std::optional<MapSlice> slice =
+          sliceFor(*client, common, mapped_for_client ? mapped : nullptr, answers_client,
+                   answers_client ? answers : 0, loops, masks);
+      if (slice) outgoing.emplace_back(&client->publish, std::move(*slice));
     }
-    slice.loops_closed = static_cast<std::uint32_t>(loops - loops_published_);
-    loops_published_ = loops;
-    MutexLock state(state_mutex_);
-    slice.sequence = ++slice_sequence_;
-    // A correction answers no upload.
-    // The slice answers the upload of the keyframe it mapped (later uploads may be queued).
-    slice.upload_sequence = answers;
-    if (mapped != nullptr) {
-      const auto it = upload_of_keyframe_.find(mapped->id());
-      if (it != upload_of_keyframe_.end()) {
-        slice.upload_sequence = it->second;
-        upload_of_keyframe_.erase(it);
-      }
-    }
-    slice.newest_keyframe = newest_keyframe_;
-    ++stats_.slices;
-    if (window_.bounded()) {
-      stats_.client_keyframes_held = window_.held().size();
-      stats_.client_keyframes_evicted += slice.keyframes_evicted.size();
-      stats_.client_keyframes_resent += slice.keyframes.size() - entering_before;
-    }
-    stats_.keyframes = map_.keyFrameCount();
-    stats_.map_points = map_.pointCount();
   }
-  if (publish_) publish_(std::move(slice));
+  for (auto& [publish, slice] : outgoing) {
+    if (*publish) (*publish)(std::move(slice));
+  }
 }
 
-void EdgeMapSession::publishFullResync() {
+std::optional<MapSlice> EdgeMapSession::sliceFor(Client& client, const MapSlice& common,
+                                                 KeyFrame* mapped, bool answers_client,
+                                                 std::uint64_t answers, std::size_t loops,
+                                                 const std::vector<MaskRecord>& masks) {
+  MapSlice slice = common;
+  // A keyframe culled as soon as it was mapped (a revisit) hands the window to the keyframe it
+  // hangs from in the spanning tree, near where the camera is.
+  KeyFrame* centre = mapped;
+  while (centre != nullptr && centre->isBad()) centre = centre->parent();
+  if (centre != nullptr) client.window_centre = centre->id();
+  // Loop corrections, global BA and the other clients' keyframes keep the window of the client's
+  // last mapped keyframe.
+  const std::size_t entering_before = slice.keyframes.size();
+  client.window.shape(map_, map_.keyFrame(client.window_centre), slice);
+  // Masks of the keyframes the client holds (a client alone gets all of them, as it always did).
+  if (clients_.size() == 1) {
+    slice.masks = masks;
+  } else {
+    for (const MaskRecord& mask : masks) {
+      if (client.window.holds(mask.keyframe)) slice.masks.push_back(mask);
+    }
+  }
+  if (clients_.size() > 1 && !answers_client && loops == client.loops_published &&
+      slice.keyframes.empty() && slice.keyframes_evicted.empty() &&
+      slice.keyframes_erased.empty() && slice.points_upserted.empty() &&
+      slice.point_positions.empty() && slice.points_erased.empty() && slice.masks.empty() &&
+      std::none_of(slice.keyframe_poses.begin(), slice.keyframe_poses.end(),
+                   [&](const KeyFramePoseRecord& pose) { return client.window.holds(pose.id); })) {
+    return std::nullopt;  // another client's keyframe far from this one
+  }
+  slice.map_keyframes = map_.keyFrameCount();
+  slice.map_points = map_.pointCount();
+  if (mapped != nullptr) {
+    slice.processed_keyframe = mapped->id();
+    if (!mapped->isBad()) {
+      slice.reference_keyframe = mapped->id();
+      slice.reference_pose = mapped->pose();
+    }
+  }
+  slice.loops_closed = static_cast<std::uint32_t>(loops - client.loops_published);
+  client.loops_published = loops;
+  slice.sequence = ++client.slice_sequence;
+  // A correction answers no upload. The slice answers the upload of the keyframe it mapped (later
+  // uploads may be queued).
+  slice.upload_sequence = answers;
+  if (mapped != nullptr) {
+    const auto it = client.upload_of_keyframe.find(mapped->id());
+    if (it != client.upload_of_keyframe.end()) {
+      slice.upload_sequence = it->second;
+      client.upload_of_keyframe.erase(it);
+    }
+  }
+  slice.newest_keyframe = client.newest_keyframe;
+  MutexLock state(state_mutex_);
+  ++stats_.slices;
+  if (client.window.bounded()) {
+    if (mapped != nullptr || clients_.size() == 1) {
+      stats_.client_keyframes_held = client.window.held().size();
+    }
+    stats_.client_keyframes_evicted += slice.keyframes_evicted.size();
+    stats_.client_keyframes_resent += slice.keyframes.size() - entering_before;
+  }
+  stats_.keyframes = map_.keyFrameCount();
+  stats_.map_points = map_.pointCount();
+  return slice;
+}
+
+void EdgeMapSession::publishFullResync(EdgeMapClientId client_id) {
   MutexLock publishing(publish_mutex_);
   MapSlice slice;
+  const Publish* publish = nullptr;
+  std::vector<std::pair<const Publish*, MapSlice>> to_others;
   {
     MutexLock lock(map_.updateMutex());
-    // What changed since the last slice is in the whole map sent now; the store still needs it.
+    Client& client = clientLocked(client_id);
+    publish = &client.publish;
+    // What changed since the last slice is in the whole map sent now; the store still needs it,
+    // and the other clients get it in their next slice.
     MapChanges changes = map_.takeChanges();
     if (observer_ != nullptr) observer_->onMapChanged(changes);
+    if (clients_.size() > 1) {
+      const MapSlice common = buildSlice(map_, changes);
+      for (auto& [id, other] : clients_) {
+        if (id == client_id) continue;
+        if (std::optional<MapSlice> theirs =
+                sliceFor(*other, common, nullptr, false, 0, backend_->loops(), {})) {
+          to_others.emplace_back(&other->publish, std::move(*theirs));
+        }
+      }
+    }
     slice.full_resync = true;
     for (const KeyFrame* keyframe : map_.keyFrames()) {
       if (keyframe->isBad()) continue;
@@ -257,16 +384,19 @@ void EdgeMapSession::publishFullResync() {
     slice.map_keyframes = map_.keyFrameCount();
     slice.map_points = map_.pointCount();
     const std::size_t loops = backend_->loops();
-    slice.loops_closed = static_cast<std::uint32_t>(loops - loops_published_);
-    loops_published_ = loops;
-    MutexLock state(state_mutex_);
-    slice.sequence = ++slice_sequence_;
+    slice.loops_closed = static_cast<std::uint32_t>(loops - client.loops_published);
+    client.loops_published = loops;
+    slice.sequence = ++client.slice_sequence;
     // newest_keyframe stays unset: the client must not drop observations in its own keyframes
     // that the edge lacks (it re-sends those keyframes).
+    MutexLock state(state_mutex_);
     ++stats_.slices;
     ++stats_.full_resyncs;
   }
-  if (publish_) publish_(std::move(slice));
+  if (*publish) (*publish)(std::move(slice));
+  for (auto& [other, theirs] : to_others) {
+    if (*other) (*other)(std::move(theirs));
+  }
 }
 
 void EdgeMapSession::onSegmented(KeyFrameSegmentationResult result) {
@@ -282,6 +412,35 @@ void EdgeMapSession::onSegmented(KeyFrameSegmentationResult result) {
     pending_masks_.push_back(std::move(mask));
   }
   publishSlice(nullptr);
+}
+
+void EdgeMapSession::onPartsMerged(const MapPartMerge& merge) {
+  MutexLock lock(moves_mutex_);
+  part_moves_.push_back({merge.world, {merge.moved.begin(), merge.moved.end()}});
+}
+
+std::optional<Sim3d> EdgeMapSession::partMoveMissedBy(const KeyFrameRecord& record) {
+  const KeyFrame* parent = map_.keyFrame(record.parent);
+  if (parent == nullptr) return std::nullopt;
+  MutexLock lock(moves_mutex_);
+  std::optional<Sim3d> world;
+  SE3d pose = record.T_cw;
+  for (PartMove& move : part_moves_) {
+    if (!move.moved.contains(parent->id())) continue;
+    // Tracked before its client applied the move, it lies as far from its parent's new place as
+    // the move was; tracked after, it is near it already.
+    const SE3d candidate = (Sim3d(pose) * move.world.inverse()).toSE3();
+    const Eigen::Vector3d there = parent->cameraCenter();
+    if ((candidate.inverse().translation() - there).norm() >=
+        (pose.inverse().translation() - there).norm()) {
+      continue;
+    }
+    pose = candidate;
+    world = world ? move.world * *world : move.world;
+    // Its client's next keyframes, tracked against it before the client heard, follow it too.
+    move.moved.insert(record.id);
+  }
+  return world;
 }
 
 void EdgeMapSession::setNmsThreshold(float nm) {

@@ -1,15 +1,22 @@
 #pragma once
-// One client's session on the edge: the global map, fed by the client's keyframe uploads and kept
-// by local mapping on its own thread and, with a vocabulary, by loop closing on another; after each
-// mapped keyframe, loop correction and global bundle adjustment, what changed goes back to the
-// client as a map slice.
+// A map on the edge and the clients that map into it: the global map, fed by the clients' keyframe
+// uploads and kept by local mapping on its own thread and, with a vocabulary, by loop closing on
+// another; after each mapped keyframe, loop correction and global bundle adjustment, what changed
+// goes back to each client as a map slice bounded to its own window. One client (made with the
+// session) is the common case; others join a named map another client writes (addClient), each
+// with its own window, slice sequence and uploads.
 #include <cstdint>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <unordered_map>
+#include <unordered_set>
+#include <vector>
 
 #include "geometry/camera.h"
+#include "geometry/sim3.h"
 #include "map/map.h"
 #include "map/map_change_observer.h"
 #include "map/map_records.h"
@@ -40,6 +47,9 @@ struct EdgeMapSessionOptions {
   // recognition and taken as held by the client.
   std::function<void(Map&)> preload;
 };
+
+// A client of the session: 0 is the one it was made with.
+using EdgeMapClientId = std::uint32_t;
 
 struct EdgeMapSessionStats {
   std::uint64_t uploads = 0;
@@ -73,15 +83,28 @@ class EdgeMapSession {
   EdgeMapSession(const EdgeMapSession&) = delete;
   EdgeMapSession& operator=(const EdgeMapSession&) = delete;
 
+  // Another client mapping into this map: it holds nothing yet, gets slices bounded to its own
+  // window (window.keyframes > 0: it learns of the others' keyframes as they enter its window)
+  // through `publish`, from its own sequence. Throws std::invalid_argument for an unbounded
+  // window.
+  EdgeMapClientId addClient(ClientMapWindowOptions window, Publish publish);
+  // The client leaves: no slice goes to it once this returns. The map stays as it is.
+  void removeClient(EdgeMapClientId client);
+  std::size_t clientCount() const;
+  // The largest id of this origin among the map's keyframes and points (0: none): a client
+  // joining with that origin makes its ids above it.
+  std::uint64_t largestIdOfOrigin(std::uint8_t origin) const;
+
   // Adds the keyframe and its new points to the global map and queues it for mapping. Descriptors
   // the upload left out (features.descriptor_omitted) are those of the points their keypoints
   // name (fillOmittedDescriptors). Throws std::invalid_argument for records that contradict
-  // themselves.
-  void onKeyFrame(const KeyFrameUpload& upload);
-  // Publishes a slice with full_resync set: the pose of every keyframe the edge map holds (the
-  // list a client compares with its own to re-send what the edge lacks) and every point. The
-  // changes pending are taken by it (and told to the observer) as an ordinary slice takes them.
-  void publishFullResync();
+  // themselves or come from a client that is not in the session.
+  void onKeyFrame(const KeyFrameUpload& upload, EdgeMapClientId client = 0);
+  // Publishes to `client` a slice with full_resync set: the pose of every keyframe the edge map
+  // holds (the list a client compares with its own to re-send what the edge lacks) and every
+  // point. The changes pending are taken by it (and told to the observer) as an ordinary slice
+  // takes them; the other clients get them in their next slice.
+  void publishFullResync(EdgeMapClientId client = 0);
   // Waits until every queued keyframe is mapped and its slice published.
   void finish();
   void stop();
@@ -91,8 +114,8 @@ class EdgeMapSession {
   // exception: the session is over. nullopt while they run.
   std::optional<std::string> failure() const;
   Map& map() { return map_; }
-  // The keyframes the client holds (lock the map's update mutex while reading).
-  const ClientMapWindow& clientWindow() const { return window_; }
+  // The keyframes the first client holds (lock the map's update mutex while reading).
+  const ClientMapWindow& clientWindow() const { return first_client_->window; }
   // nullptr without a vocabulary or with loop closing off.
   const LoopCloser* loopCloser() const { return backend_->loopCloser(); }
   // nullptr without segmentation.
@@ -104,27 +127,59 @@ class EdgeMapSession {
   void setChangeObserver(MapChangeObserver* observer) { observer_ = observer; }
 
  private:
+  // What the session keeps for each client (under the map's update mutex).
+  struct Client {
+    Client(ClientMapWindowOptions window_options, Publish publish_to)
+        : publish(std::move(publish_to)), window(window_options) {}
+    Publish publish;
+    ClientMapWindow window;
+    KeyFrameId window_centre = kInvalidId;  // its last mapped keyframe
+    std::size_t loops_published = 0;
+    std::uint64_t slice_sequence = 0;
+    std::unordered_map<KeyFrameId, std::uint64_t> upload_of_keyframe;
+    KeyFrameId newest_keyframe = kInvalidId;
+  };
+
+  Client& clientLocked(EdgeMapClientId client) const REQUIRES(map_.updateMutex());
   // `mapped`: the keyframe just mapped, or nullptr for a loop correction or global BA.
-  // `answers`: an upload the slice answers although nothing was mapped for it (a duplicate).
-  void publishSlice(KeyFrame* mapped, std::uint64_t answers = 0);
+  // `answers`: an upload of `answered` the slice answers although nothing was mapped for it (a
+  // duplicate).
+  void publishSlice(KeyFrame* mapped, std::uint64_t answers = 0, EdgeMapClientId answered = 0);
+  // The slice of one client from the slice every client's is cut from; nullopt when nothing in
+  // it concerns the client (only for clients the slice answers nothing).
+  std::optional<MapSlice> sliceFor(Client& client, const MapSlice& common, KeyFrame* mapped,
+                                   bool answers_client, std::uint64_t answers, std::size_t loops,
+                                   const std::vector<MaskRecord>& masks)
+      REQUIRES(map_.updateMutex());
   void adoptPreloadedMap();
   void onSegmented(KeyFrameSegmentationResult result);
+  void onPartsMerged(const MapPartMerge& merge);
+  // An upload tracked against a keyframe that a merge has moved since, before its client heard of
+  // it, is in the frame the part had: the move it must make (new world point = move * old one),
+  // nullopt when it needs none.
+  std::optional<Sim3d> partMoveMissedBy(const KeyFrameRecord& record) REQUIRES(map_.updateMutex());
+
+  // Parts of the map a loop moved onto another (two clients' parts merged).
+  struct PartMove {
+    Sim3d world;  // new world point = world * old one
+    std::unordered_set<KeyFrameId> moved;
+  };
 
   PinholeCamera camera_;
   Map map_;
   MapChangeObserver* observer_ = nullptr;
   int mask_downscale_;
-  Publish publish_;
-  ClientMapWindow window_ GUARDED_BY(map_.updateMutex());
-  KeyFrameId window_centre_ GUARDED_BY(map_.updateMutex()) = kInvalidId;  // the last mapped
+  std::map<EdgeMapClientId, std::unique_ptr<Client>> clients_ GUARDED_BY(map_.updateMutex());
+  EdgeMapClientId next_client_ GUARDED_BY(map_.updateMutex()) = 1;
+  // Taken under the map's update mutex (the merge tells of a move while it holds it).
+  Mutex moves_mutex_;
+  std::vector<PartMove> part_moves_ GUARDED_BY(moves_mutex_);
+  Client* first_client_ = nullptr;  // client 0, for clientWindow(); gone once it leaves
 
-  // Mapping and loop closing publish from their own threads: slices leave in sequence order.
+  // Mapping and loop closing publish from their own threads: slices leave in sequence order, and
+  // a client leaves (removeClient) between two slices.
   Mutex publish_mutex_;
-  std::size_t loops_published_ GUARDED_BY(publish_mutex_) = 0;
   mutable Mutex state_mutex_;  // guards the fields below (not the map)
-  std::uint64_t slice_sequence_ GUARDED_BY(state_mutex_) = 0;
-  std::unordered_map<KeyFrameId, std::uint64_t> upload_of_keyframe_ GUARDED_BY(state_mutex_);
-  KeyFrameId newest_keyframe_ GUARDED_BY(state_mutex_) = kInvalidId;
   EdgeMapSessionStats stats_ GUARDED_BY(state_mutex_);
   std::vector<MaskRecord> pending_masks_ GUARDED_BY(state_mutex_);
 

@@ -42,21 +42,11 @@ std::uint64_t SessionRegistry::reclaimableLocked() const {
   return victim;
 }
 
-namespace {
-
-// The named map a session writes into, or "" (a new map the edge names, or a localise-only one).
-std::string mapWrittenBy(const SessionConfig& config) {
-  return config.settings.localize_only ? std::string() : config.map_name;
-}
-
-}  // namespace
-
 std::shared_ptr<ServerSession> SessionRegistry::removeLocked(std::uint64_t session_id) {
   const auto it = sessions_.find(session_id);
   if (it == sessions_.end()) return nullptr;
   std::shared_ptr<ServerSession> session = std::move(it->second);
   sessions_.erase(it);
-  maps_written_.erase(mapWrittenBy(session->config));
   origin_in_use_[session->config.id_origin] = false;
   --reserved_;
   releaseOwnerLocked(session->owner);
@@ -108,15 +98,7 @@ std::shared_ptr<ServerSession> SessionRegistry::open(SessionConfig config,
         ++reclaimed_;
       }
     }
-    const std::string map = mapWrittenBy(config);
-    if (!map.empty() && maps_written_.contains(map)) {
-      throw std::invalid_argument(fmt::format(
-          "map '{}' is being written by another client's session; several clients in one map "
-          "are not supported yet: name another map (--map), or localise in it (--localize-only)",
-          map));
-    }
     config.id_origin = reserveOriginLocked(config.id_origin);
-    if (!map.empty()) maps_written_.insert(map);
     ++owner_sessions_[owner.name];
     do {
       config.session_id = random_();
@@ -139,7 +121,6 @@ std::shared_ptr<ServerSession> SessionRegistry::open(SessionConfig config,
     MutexLock lock(mutex_);
     origin_in_use_[session->config.id_origin] = false;
     --reserved_;
-    maps_written_.erase(mapWrittenBy(session->config));
     releaseOwnerLocked(session->owner);
     throw;
   }

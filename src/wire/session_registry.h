@@ -6,7 +6,6 @@
 #include <map>
 #include <memory>
 #include <random>
-#include <set>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -119,9 +118,6 @@ class SessionRegistry {
   std::atomic<std::uint64_t> reclaimed_{0};
   // Open or being opened, per owner.
   std::map<std::string, std::size_t> owner_sessions_ GUARDED_BY(mutex_);
-  // Named maps a live (or opening) session writes into: one writer each (several clients in one
-  // map are not supported yet; localise-only sessions only read).
-  std::set<std::string> maps_written_ GUARDED_BY(mutex_);
   mutable Mutex totals_mutex_;
   ClosedSessionTotals closed_totals_ GUARDED_BY(totals_mutex_);
 };

@@ -165,36 +165,6 @@ TEST_F(EdgeLoopback, TwoSessionsGetDistinctOrigins) {
   EXPECT_TRUE(test::eventually([&] { return server->sessionCount() == 1; }));
 }
 
-// One writer per named map (several clients in one map are not supported yet): a second client
-// naming a map another live session writes into is refused with a clear message; localising in it
-// is not writing; once the writer has closed, the name is free again.
-TEST_F(EdgeLoopback, ASecondWriterOfANamedMapIsRefused) {
-  SessionConfig writer = test::sampleSessionConfig("first");
-  writer.map_name = "kitchen";
-  EdgeClient a(server->address(), writer, clientOptions());
-  SessionConfig second = test::sampleSessionConfig("second");
-  second.map_name = "kitchen";
-  try {
-    EdgeClient b(server->address(), second, clientOptions());
-    ADD_FAILURE() << "a second writer of 'kitchen' was let in";
-  } catch (const EdgeClientError& e) {
-    EXPECT_NE(std::string(e.what()).find("map 'kitchen' is being written"), std::string::npos)
-        << e.what();
-  }
-  SessionConfig other = test::sampleSessionConfig("other");
-  other.map_name = "hall";
-  EdgeClient c(server->address(), other, clientOptions());
-  SessionConfig reader = test::sampleSessionConfig("reader");
-  reader.map_name = "kitchen";
-  reader.settings.localize_only = true;
-  EdgeClient d(server->address(), reader, clientOptions());
-  EXPECT_EQ(server->sessionCount(), 3u);
-  a.close();
-  EXPECT_TRUE(test::eventually([&] { return server->sessionCount() == 2; }));
-  EdgeClient e(server->address(), second, clientOptions());
-  EXPECT_EQ(server->sessionCount(), 3u);
-}
-
 TEST_F(EdgeLoopback, OffloadFrameReturnsThePose) {
   EdgeClient client(server->address(), test::sampleSessionConfig(), clientOptions());
   const auto result = client.offloadFrame({41, 1.5, "jpeg", test::sampleFrameImage(), "", {}});

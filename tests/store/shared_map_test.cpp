@@ -1,0 +1,146 @@
+// Two clients mapping one map at once, as a user meets it (issue "Map service II"): a real edge
+// server with a store, two real clients playing redkitchen RGB-D frames 0-549 and 450-999 into
+// `--map kitchen` at the same time. The second client starts where the map has nothing of its
+// own yet: it maps in a part of its own, and a loop between the two parts merges them. The stored
+// map then holds both clients' keyframes in one frame: its keyframe ATE, with one SE(3) alignment
+// for all of them, is compared with a single client's over the whole sequence into its own map.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "io/trajectory.h"
+#include "support/child_process.h"
+#include "support/edgeslam_command.h"
+#include "support/fresh_temp_dir.h"
+#include "support/shared_data.h"
+#include "support/small_vocabulary.h"
+
+namespace edgeslam {
+namespace {
+
+constexpr const char* kSequence = "datasets/7scenes-redkitchen-1000";
+constexpr auto kServerReady = std::chrono::seconds(60);
+constexpr auto kClientRun = std::chrono::minutes(10);
+
+std::vector<std::string> words(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string word; in >> word;) out.push_back(word);
+  return out;
+}
+
+// The clients' ground truth together (each run writes its frames'), one line per timestamp.
+void writeJointGroundTruth(const std::vector<std::filesystem::path>& runs,
+                           const std::filesystem::path& file) {
+  std::map<double, StampedPose> joint;
+  for (const auto& run : runs) {
+    for (const StampedPose& pose : readTumTrajectory(run / "groundtruth.tum")) {
+      joint.emplace(pose.timestamp, pose);
+    }
+  }
+  std::vector<StampedPose> poses;
+  for (const auto& [t, pose] : joint) poses.push_back(pose);
+  writeTumTrajectory(file, poses);
+}
+
+struct StoredMapFigures {
+  std::size_t keyframes = 0;
+  std::size_t keyframes_first_only = 0;   // frames only the first client played (< 450)
+  std::size_t keyframes_second_only = 0;  // frames only the second client played (> 549)
+  double ate_m = -1.0;
+};
+
+StoredMapFigures storedMap(const std::filesystem::path& store, const std::string& map,
+                           const std::filesystem::path& ground_truth,
+                           const std::filesystem::path& work) {
+  StoredMapFigures figures;
+  const auto keyframes = work / (map + "_keyframes.tum");
+  const auto exported = test::runEdgeslam("map export " + map + " --format tum --out " +
+                                          keyframes.string() + " --maps " + store.string());
+  EXPECT_EQ(exported.exit_code, 0) << exported.output;
+  for (const StampedPose& pose : readTumTrajectory(keyframes)) {
+    ++figures.keyframes;
+    const double frame = pose.timestamp * 30.0;  // 7-Scenes frames are 1/30 s apart
+    if (frame < 449.5) ++figures.keyframes_first_only;
+    if (frame > 549.5) ++figures.keyframes_second_only;
+  }
+  const auto ate = test::runEdgeslam("eval ate --gt " + ground_truth.string() + " --est " +
+                                         keyframes.string() + " --align se3 --json",
+                                     false);
+  const auto json = nlohmann::json::parse(ate.output, nullptr, false);
+  if (json.is_object() && json.contains("rmse_m")) figures.ate_m = json["rmse_m"].get<double>();
+  return figures;
+}
+
+TEST(SharedMap, TwoClientsMappingOneMapAtOnceEndInOneFrame) {
+  EDGESLAM_REQUIRE_SHARED(kSequence);
+  const auto work = test::freshTempDir("shared_map");
+  const auto store = work / "store";
+  const auto logs = work / "logs";
+  std::filesystem::create_directories(logs);
+  const std::string vocab =
+      " --vocab " + test::writeSmallVocabulary(test::freshTempDir("shared_map_vocab"));
+  const std::string dataset = " --dataset " + test::sharedPath(kSequence).string();
+  const int port = 47900 + static_cast<int>(::getpid() % 90);
+  const std::string address = "127.0.0.1:" + std::to_string(port);
+  test::ChildProcess server(test::edgeslamBinary(),
+                            words("server --listen " + address + " --status-every 0" + vocab +
+                                  " --semantic off --maps " + store.string()),
+                            logs / "server.log");
+  ASSERT_TRUE(server.waitForLog("listening", kServerReady)) << server.log();
+
+  const auto client = [&](const std::string& name, const std::string& frames,
+                          const std::string& map) {
+    return std::make_unique<test::ChildProcess>(
+        test::edgeslamBinary(),
+        words("client --server " + address + dataset + " --frames " + frames +
+              " --sensor rgbd --map " + map + vocab + " --out " +
+              (work / name).string()),
+        logs / (name + ".log"));
+  };
+  // The two halves at once, into one map.
+  auto first = client("first", "0-549", "kitchen");
+  auto second = client("second", "450-999", "kitchen");
+  EXPECT_EQ(first->wait(kClientRun), 0) << first->log();
+  EXPECT_EQ(second->wait(kClientRun), 0) << second->log();
+  // One client over the whole sequence into a map of its own: the accuracy to match.
+  auto whole = client("whole", "0-999", "whole");
+  EXPECT_EQ(whole->wait(kClientRun), 0) << whole->log();
+  server.signal(SIGTERM);
+  EXPECT_EQ(server.wait(std::chrono::seconds(60)), 0) << server.log();
+  const std::string server_log = server.log();
+
+  // The second client joined the first's map, and a loop merged their parts.
+  EXPECT_NE(server_log.find("joins map 'kitchen'"), std::string::npos) << server_log;
+  EXPECT_NE(server_log.find("maps merged"), std::string::npos) << server_log;
+
+  writeJointGroundTruth({work / "first", work / "second"}, work / "halves_truth.tum");
+  const StoredMapFigures shared = storedMap(store, "kitchen", work / "halves_truth.tum", work);
+  const StoredMapFigures single =
+      storedMap(store, "whole", work / "whole" / "groundtruth.tum", work);
+  std::printf(
+      "shared map: %zu keyframes (%zu of frames only the first client played, %zu only the "
+      "second's), keyframe ATE %.2f cm; single client: %zu keyframes, %.2f cm (ratio %.2f)\n",
+      shared.keyframes, shared.keyframes_first_only, shared.keyframes_second_only,
+      shared.ate_m * 100, single.keyframes, single.ate_m * 100, shared.ate_m / single.ate_m);
+  EXPECT_GE(shared.keyframes_first_only, 10u);
+  EXPECT_GE(shared.keyframes_second_only, 10u);
+  ASSERT_GT(single.ate_m, 0.0);
+  ASSERT_GT(shared.ate_m, 0.0);
+  // Both halves in one frame: one alignment fits them as well as it fits one client's map (the
+  // issue's bound is 20 %; a map left in two frames is off by tens of centimetres).
+  EXPECT_LT(shared.ate_m, 1.2 * single.ate_m + 0.005);
+  std::filesystem::remove_all(work);
+}
+
+}  // namespace
+}  // namespace edgeslam
