@@ -16,12 +16,11 @@ namespace {
 // optimises: those made after the slice's keyframe were placed against the map as it was, so when
 // the slice moves that keyframe they follow it rigidly, keeping their relation to the map they
 // were tracked in (as a loop correction carries the keyframes beyond the loop).
-std::size_t carryNewerKeyFrames(Map& map, const MapSlice& slice, const SE3d& anchor_before,
+std::size_t carryNewerKeyFrames(Map& map, KeyFrameId anchor, const SE3d& anchor_before,
                                 const SE3d& anchor_after,
                                 const std::unordered_set<MapPointId>& points_in_slice,
                                 const std::unordered_set<KeyFrameId>& keyframes_in_slice)
     REQUIRES(map.updateMutex()) {
-  const KeyFrameId anchor = slice.processed_keyframe;
   const SE3d world_correction = anchor_after.inverse() * anchor_before;  // old world -> new world
   const SE3d pose_correction = anchor_before.inverse() * anchor_after;   // T_cw' = T_cw * this
   std::unordered_set<MapPointId> carried_points;
@@ -92,10 +91,15 @@ SliceApplyResult applySlice(Map& map, const MapSlice& slice, const PinholeCamera
       }
     }
   }
-  std::optional<std::pair<SE3d, SE3d>> anchor_move;  // the processed keyframe's before, after
+  // The keyframes newer than the anchor follow its move: the keyframe the slice mapped or, for a
+  // loop correction (or a merge of two parts of the map), the newest the edge had of this client.
+  const KeyFrameId anchor = slice.processed_keyframe != kInvalidId ? slice.processed_keyframe
+                            : slice.loops_closed > 0               ? slice.newest_keyframe
+                                                                   : kInvalidId;
+  std::optional<std::pair<SE3d, SE3d>> anchor_move;  // the anchor keyframe's before, after
   for (const KeyFramePoseRecord& record : slice.keyframe_poses) {
     if (KeyFrame* kf = map.keyFrame(record.id)) {
-      if (record.id == slice.processed_keyframe) anchor_move.emplace(kf->pose(), record.T_cw);
+      if (record.id == anchor) anchor_move.emplace(kf->pose(), record.T_cw);
       map.setKeyFramePose(kf, record.T_cw);
       ++result.keyframes_moved;
     }
@@ -130,7 +134,7 @@ SliceApplyResult applySlice(Map& map, const MapSlice& slice, const PinholeCamera
       ++result.points_moved;
     }
   }
-  if (anchor_move && slice.processed_keyframe != kInvalidId) {
+  if (anchor_move && anchor != kInvalidId) {
     std::unordered_set<MapPointId> points_in_slice;
     for (const MapPointRecord& record : slice.points_upserted) points_in_slice.insert(record.id);
     for (const PointPositionRecord& record : slice.point_positions) {
@@ -142,7 +146,7 @@ SliceApplyResult applySlice(Map& map, const MapSlice& slice, const PinholeCamera
     }
     for (const KeyFrameRecord& record : slice.keyframes) keyframes_in_slice.insert(record.id);
     result.keyframes_carried = carryNewerKeyFrames(
-        map, slice, anchor_move->first, anchor_move->second, points_in_slice, keyframes_in_slice);
+        map, anchor, anchor_move->first, anchor_move->second, points_in_slice, keyframes_in_slice);
   }
   for (KeyFrame* kf : touched) {
     if (kf != nullptr && !kf->isBad() && !kf->isEvicted()) map.updateConnections(kf);

@@ -9,7 +9,6 @@
 #include <vector>
 
 #include "geometry/sim3.h"
-
 #include "map/map.h"
 #include "mapping/loop_verifier.h"
 

@@ -29,7 +29,8 @@ struct LiveEdgeMap {
 
 // Why a client with `joining` cannot write into a map made by `made_by` (nullopt: it can). The
 // map has one camera model, one sensor and one kind of features; semantic culling is the map's.
-std::optional<std::string> whyCannotJoin(const SessionConfig& made_by, const SessionConfig& joining);
+std::optional<std::string> whyCannotJoin(const SessionConfig& made_by,
+                                         const SessionConfig& joining);
 
 class LiveEdgeMaps {
  public:

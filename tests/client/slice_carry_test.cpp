@@ -63,6 +63,39 @@ TEST(SliceCarry, NewerClientKeyFramesAndTheirPointsFollowTheProcessedKeyFrame) {
   EXPECT_LT((edge_point->position() - edge_point_before).norm(), 1e-12);
 }
 
+// A loop correction (or a merge of two parts of the map, which may move the client's part by
+// metres) answers no upload: the keyframes newer than the newest the edge had follow that one.
+TEST(SliceCarry, AfterALoopCorrectionNewerKeyFramesFollowTheNewestTheEdgeHad) {
+  ClientWithNewerKeyFrame t;
+  const SE3d before = t.processed->pose();
+  const SE3d after = SE3d(Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitY()).toRotationMatrix(),
+                          Eigen::Vector3d(1.5, -0.2, 0.7)) *
+                     before;
+  const SE3d newer_before = t.newer->pose();
+  MapSlice slice;
+  slice.sequence = 1;
+  slice.loops_closed = 1;
+  slice.newest_keyframe = t.processed->id();
+  slice.keyframe_poses.push_back({t.processed->id(), after, kInvalidId});
+  const SliceApplyResult applied = applySlice(t.client, slice, t.scene.camera());
+  EXPECT_EQ(applied.keyframes_carried, 1u);
+  const SE3d relative_before = newer_before * before.inverse();
+  const SE3d relative_after = t.newer->pose() * t.processed->pose().inverse();
+  EXPECT_LT((relative_before.translation() - relative_after.translation()).norm(), 1e-9);
+  EXPECT_LT(relative_before.rotation().angularDistance(relative_after.rotation()), 1e-9);
+
+  // A slice that closes no loop and answers no upload carries nothing (a global BA's moves are
+  // the edge's own, for the keyframes it has).
+  ClientWithNewerKeyFrame u;
+  const SE3d u_newer_before = u.newer->pose();
+  MapSlice plain;
+  plain.sequence = 1;
+  plain.newest_keyframe = u.processed->id();
+  plain.keyframe_poses.push_back({u.processed->id(), after, kInvalidId});
+  EXPECT_EQ(applySlice(u.client, plain, u.scene.camera()).keyframes_carried, 0u);
+  EXPECT_LT((u.newer->pose().translation() - u_newer_before.translation()).norm(), 1e-12);
+}
+
 TEST(SliceCarry, ANewerKeyFrameThatTheSliceMovesKeepsTheEdgesPose) {
   ClientWithNewerKeyFrame t;
   const SE3d processed_after =

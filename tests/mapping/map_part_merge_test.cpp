@@ -61,8 +61,10 @@ struct TwoParts {
 };
 
 Sim3d someFrame(double scale) {
-  return Sim3d(scale, Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.2, 1.0, 0.1).normalized())),
-               Eigen::Vector3d(1.5, -0.4, 2.0));
+  return Sim3d(
+      scale,
+      Eigen::Quaterniond(Eigen::AngleAxisd(0.7, Eigen::Vector3d(0.2, 1.0, 0.1).normalized())),
+      Eigen::Vector3d(1.5, -0.4, 2.0));
 }
 
 void expectSecondPartInTheFirstsFrame(TwoParts& parts) REQUIRES(parts.map.updateMutex()) {
@@ -110,8 +112,7 @@ TEST(MapPartMerge, ALoopFromTheSecondPartMovesItOntoTheFirst) {
     EXPECT_TRUE(connectedPart(parts.second.front()).contains(parts.first.front()));
     EXPECT_EQ(loop.current->parent(), loop.loop);
     // The loop's relation now holds where the current keyframe is.
-    EXPECT_LT((loop.S_cw.toSE3().translation() - loop.current->pose().translation()).norm(),
-              1e-9);
+    EXPECT_LT((loop.S_cw.toSE3().translation() - loop.current->pose().translation()).norm(), 1e-9);
     // A second loop across the seam is an ordinary one.
     EXPECT_FALSE(mergeSeparateParts(parts.map, loop).merged);
   }

@@ -103,8 +103,7 @@ TEST(SharedMap, TwoClientsMappingOneMapAtOnceEndInOneFrame) {
     return std::make_unique<test::ChildProcess>(
         test::edgeslamBinary(),
         words("client --server " + address + dataset + " --frames " + frames +
-              " --sensor rgbd --map " + map + vocab + " --out " +
-              (work / name).string()),
+              " --sensor rgbd --map " + map + vocab + " --out " + (work / name).string()),
         logs / (name + ".log"));
   };
   // The two halves at once, into one map.
