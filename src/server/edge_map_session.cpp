@@ -264,15 +264,18 @@ void EdgeMapSession::publishSlice(KeyFrame* mapped, std::uint64_t answers,
       observer_->onMapChanged(changes);
       if (!masks.empty()) observer_->onMasks(masks);
     }
-    const MapSlice common = buildSlice(map_, changes);
+    MapSlice common = buildSlice(map_, changes);
+    std::size_t left = clients_.size();
     for (auto& [id, client] : clients_) {
+      // Each client's slice is cut from the common one; the last takes it.
+      MapSlice base = --left == 0 ? std::move(common) : common;
       // A client alone had every keyframe mapped for it (one loaded, or uploaded before a reset).
       const bool mapped_for_client =
           mapped != nullptr &&
           (clients_.size() == 1 || client->upload_of_keyframe.contains(mapped->id()));
       const bool answers_client = mapped_for_client || (answers != 0 && id == answered);
       std::optional<MapSlice> slice =
-          sliceFor(*client, common, mapped_for_client ? mapped : nullptr, answers_client,
+          sliceFor(*client, std::move(base), mapped_for_client ? mapped : nullptr, answers_client,
                    answers_client ? answers : 0, loops, masks);
       if (slice) outgoing.emplace_back(&client->publish, std::move(*slice));
     }
@@ -282,11 +285,10 @@ void EdgeMapSession::publishSlice(KeyFrame* mapped, std::uint64_t answers,
   }
 }
 
-std::optional<MapSlice> EdgeMapSession::sliceFor(Client& client, const MapSlice& common,
-                                                 KeyFrame* mapped, bool answers_client,
-                                                 std::uint64_t answers, std::size_t loops,
+std::optional<MapSlice> EdgeMapSession::sliceFor(Client& client, MapSlice slice, KeyFrame* mapped,
+                                                 bool answers_client, std::uint64_t answers,
+                                                 std::size_t loops,
                                                  const std::vector<MaskRecord>& masks) {
-  MapSlice slice = common;
   // A keyframe culled as soon as it was mapped (a revisit) hands the window to the keyframe it
   // hangs from in the spanning tree, near where the camera is.
   KeyFrame* centre = mapped;
@@ -367,7 +369,7 @@ void EdgeMapSession::publishFullResync(EdgeMapClientId client_id) {
       for (auto& [id, other] : clients_) {
         if (id == client_id) continue;
         if (std::optional<MapSlice> theirs =
-                sliceFor(*other, common, nullptr, false, 0, backend_->loops(), {})) {
+                sliceFor(*other, MapSlice(common), nullptr, false, 0, backend_->loops(), {})) {
           to_others.emplace_back(&other->publish, std::move(*theirs));
         }
       }

@@ -147,7 +147,7 @@ class EdgeMapSession {
   void publishSlice(KeyFrame* mapped, std::uint64_t answers = 0, EdgeMapClientId answered = 0);
   // The slice of one client from the slice every client's is cut from; nullopt when nothing in
   // it concerns the client (only for clients the slice answers nothing).
-  std::optional<MapSlice> sliceFor(Client& client, const MapSlice& common, KeyFrame* mapped,
+  std::optional<MapSlice> sliceFor(Client& client, MapSlice slice, KeyFrame* mapped,
                                    bool answers_client, std::uint64_t answers, std::size_t loops,
                                    const std::vector<MaskRecord>& masks)
       REQUIRES(map_.updateMutex());
