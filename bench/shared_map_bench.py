@@ -13,6 +13,7 @@ many keyframes moved.
 Writes the table to docs/benchmarks.md (between the SHARED-MAP markers) unless --no-docs. Usage:
   bench/shared_map_bench.py [--build build] [--shared ../shared] [--sensors rgbd,mono]
                             [--runs 5] [--first 0-549] [--second 450-999]
+                            [--pacing fast|realtime]
 """
 import argparse
 import json
@@ -74,7 +75,7 @@ class Server:
     def client(self, args, sensor, frames, map_name, out):
         command = [args.edgeslam, "client", "--server", f"127.0.0.1:{self.port}", "--dataset",
                    args.dataset, "--frames", frames, "--sensor", sensor, "--map", map_name,
-                   "--out", out]
+                   "--out", out, "--" + args.pacing]
         return subprocess.Popen(command, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
 
     def stop(self):
@@ -132,8 +133,8 @@ def table(args, results, host):
     lines = [
         f"Measured {time.strftime('%Y-%m-%d')} with `bench/shared_map_bench.py --runs {args.runs}` "
         f"({os.path.basename(args.dataset)}, frames {args.first} and {args.second}, two clients "
-        "with --fast on one 2-core host with the server). Keyframe ATE of the stored map against "
-        "the clients' ground truth together, one alignment for the whole map (SE(3) RGB-D, Sim(3) "
+        f"with --{args.pacing} on one 2-core host with the server). Keyframe ATE of the stored "
+        "map against the clients' ground truth together, one alignment for the whole map (SE(3) RGB-D, Sim(3) "
         "monocular): median (min-max) in cm. \"together\": both clients at once into one map; "
         "\"in turn\": the second after the first, resuming the stored map; \"alone\": one client "
         "over both stretches. Merged: runs whose two parts a loop merged; at: the frame of the "
@@ -170,6 +171,7 @@ def main():
     parser.add_argument("--runs", type=int, default=5)
     parser.add_argument("--first", default="0-549")
     parser.add_argument("--second", default="450-999")
+    parser.add_argument("--pacing", choices=["fast", "realtime"], default="fast")
     parser.add_argument("--no-docs", action="store_true")
     args = parser.parse_args()
     args.edgeslam = os.path.join(args.build, "edgeslam")
