@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <optional>
+#include <unordered_map>
 #include <unordered_set>
 #include <utility>
 #include <vector>
@@ -16,13 +17,23 @@ namespace {
 // optimises: those made after the slice's keyframe were placed against the map as it was, so when
 // the slice moves that keyframe they follow it rigidly, keeping their relation to the map they
 // were tracked in (as a loop correction carries the keyframes beyond the loop).
+// `scale`: how much farther the anchor's surroundings lie from it after the correction (1 but for
+// a monocular loop or merge, which corrects scale too): carried keyframes keep their rotation
+// relative to the anchor and their offset from it times `scale`; their points likewise.
 std::size_t carryNewerKeyFrames(Map& map, KeyFrameId anchor, const SE3d& anchor_before,
-                                const SE3d& anchor_after,
+                                const SE3d& anchor_after, double scale,
                                 const std::unordered_set<MapPointId>& points_in_slice,
                                 const std::unordered_set<KeyFrameId>& keyframes_in_slice)
     REQUIRES(map.updateMutex()) {
-  const SE3d world_correction = anchor_after.inverse() * anchor_before;  // old world -> new world
-  const SE3d pose_correction = anchor_before.inverse() * anchor_after;   // T_cw' = T_cw * this
+  const SE3d anchor_before_inverse = anchor_before.inverse();
+  const SE3d anchor_after_inverse = anchor_after.inverse();
+  const auto carryPose = [&](const SE3d& pose) {
+    const SE3d relative = pose * anchor_before_inverse;  // anchor camera -> this camera
+    return SE3d(relative.rotation(), scale * relative.translation()) * anchor_after;
+  };
+  const auto carryPoint = [&](const Eigen::Vector3d& position) {  // old world -> new world
+    return anchor_after_inverse * (scale * (anchor_before * position));
+  };
   std::unordered_set<MapPointId> carried_points;
   std::size_t carried = 0;
   for (KeyFrame* kf : map.keyFrames()) {
@@ -30,22 +41,53 @@ std::size_t carryNewerKeyFrames(Map& map, KeyFrameId anchor, const SE3d& anchor_
         keyframes_in_slice.contains(kf->id())) {
       continue;  // the edge's own pose for it, when the slice has one, is the one to keep
     }
-    map.setKeyFramePose(kf, kf->pose() * pose_correction);
+    map.setKeyFramePose(kf, carryPose(kf->pose()));
     ++carried;
     for (MapPoint* p : kf->points()) {
       if (p == nullptr || p->isBad() || points_in_slice.contains(p->id())) continue;
       const KeyFrameId born = p->firstKeyFrameId();
       if (born == kInvalidId || idOrigin(born) != idOrigin(anchor) || born <= anchor) continue;
       if (!carried_points.insert(p->id()).second) continue;
-      map.relocatePoint(p, world_correction * p->position());
+      map.relocatePoint(p, carryPoint(p->position()));
     }
   }
   return carried;
 }
 
+// Distances from a keyframe's camera centre to the points it sees, by point.
+std::unordered_map<MapPointId, double> pointDistances(const KeyFrame& kf) {
+  std::unordered_map<MapPointId, double> distances;
+  const Eigen::Vector3d centre = kf.cameraCenter();
+  for (const MapPoint* p : kf.points()) {
+    if (p != nullptr && !p->isBad()) distances.emplace(p->id(), (p->position() - centre).norm());
+  }
+  return distances;
+}
+
+// The scale a correction gave the anchor's surroundings: the median ratio of its points'
+// distances after and before, over the points the slice moved (1 with fewer than a few).
+double correctionScale(const KeyFrame& anchor,
+                       const std::unordered_map<MapPointId, double>& distances_before,
+                       const std::unordered_set<MapPointId>& points_in_slice) {
+  constexpr std::size_t kMinPoints = 8;
+  std::vector<double> ratios;
+  const Eigen::Vector3d centre = anchor.cameraCenter();
+  for (const MapPoint* p : anchor.points()) {
+    if (p == nullptr || p->isBad() || !points_in_slice.contains(p->id())) continue;
+    const auto before = distances_before.find(p->id());
+    if (before == distances_before.end() || !(before->second > 0.0)) continue;
+    ratios.push_back((p->position() - centre).norm() / before->second);
+  }
+  if (ratios.size() < kMinPoints) return 1.0;
+  const auto middle = ratios.begin() + static_cast<std::ptrdiff_t>(ratios.size() / 2);
+  std::nth_element(ratios.begin(), middle, ratios.end());
+  return *middle;
+}
+
 }  // namespace
 
-SliceApplyResult applySlice(Map& map, const MapSlice& slice, const PinholeCamera& camera) {
+SliceApplyResult applySlice(Map& map, const MapSlice& slice, const PinholeCamera& camera,
+                            Sensor sensor) {
   SliceApplyResult result;
   MutexLock lock(map.updateMutex());
   // What the client's map recorded of its own changes since the last slice is read by nobody (its
@@ -97,6 +139,12 @@ SliceApplyResult applySlice(Map& map, const MapSlice& slice, const PinholeCamera
                             : slice.loops_closed > 0               ? slice.newest_keyframe
                                                                    : kInvalidId;
   std::optional<std::pair<SE3d, SE3d>> anchor_move;  // the anchor keyframe's before, after
+  // A monocular loop or merge corrects scale as well: measured on the anchor's points.
+  const bool scale_may_change = sensor == Sensor::kMonocular && slice.loops_closed > 0;
+  std::unordered_map<MapPointId, double> anchor_distances_before;
+  if (const KeyFrame* kf = map.keyFrame(anchor); kf != nullptr && scale_may_change) {
+    anchor_distances_before = pointDistances(*kf);
+  }
   for (const KeyFramePoseRecord& record : slice.keyframe_poses) {
     if (KeyFrame* kf = map.keyFrame(record.id)) {
       if (record.id == anchor) anchor_move.emplace(kf->pose(), record.T_cw);
@@ -145,8 +193,13 @@ SliceApplyResult applySlice(Map& map, const MapSlice& slice, const PinholeCamera
       keyframes_in_slice.insert(record.id);
     }
     for (const KeyFrameRecord& record : slice.keyframes) keyframes_in_slice.insert(record.id);
-    result.keyframes_carried = carryNewerKeyFrames(
-        map, anchor, anchor_move->first, anchor_move->second, points_in_slice, keyframes_in_slice);
+    const KeyFrame* anchor_kf = map.keyFrame(anchor);
+    result.carry_scale = scale_may_change && anchor_kf != nullptr
+                             ? correctionScale(*anchor_kf, anchor_distances_before, points_in_slice)
+                             : 1.0;
+    result.keyframes_carried =
+        carryNewerKeyFrames(map, anchor, anchor_move->first, anchor_move->second,
+                            result.carry_scale, points_in_slice, keyframes_in_slice);
   }
   for (KeyFrame* kf : touched) {
     if (kf != nullptr && !kf->isBad() && !kf->isEvicted()) map.updateConnections(kf);

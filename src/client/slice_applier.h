@@ -16,6 +16,7 @@
 #include "geometry/camera.h"
 #include "map/map.h"
 #include "map/map_records.h"
+#include "map/sensor.h"
 
 namespace edgeslam {
 
@@ -28,6 +29,7 @@ struct SliceApplyResult {
   std::vector<KeyFrameId> erased_keyframe_ids;  // the slice's erasures the client applied
   // Keyframes newer than the slice's that followed its keyframe's correction.
   std::size_t keyframes_carried = 0;
+  double carry_scale = 1.0;     // the scale they followed with (monocular loops and merges)
   std::size_t frame_index = 0;  // of the processed keyframe, 0 when the client does not have it
   std::vector<KeyFrameId> keyframes_evicted;  // held before, evicted now
   std::vector<KeyFrameId> keyframes_entered;  // held now, not (or evicted) before
@@ -39,7 +41,9 @@ struct SliceApplyResult {
   std::vector<KeyFrameId> keyframes_edge_lacks;
 };
 
-SliceApplyResult applySlice(Map& map, const MapSlice& slice, const PinholeCamera& camera)
-    EXCLUDES(map.updateMutex());
+// `sensor`: a monocular map's loop corrections and merges change its scale, and the keyframes
+// carried with the anchor follow that too (measured on the anchor's points).
+SliceApplyResult applySlice(Map& map, const MapSlice& slice, const PinholeCamera& camera,
+                            Sensor sensor) EXCLUDES(map.updateMutex());
 
 }  // namespace edgeslam

@@ -40,7 +40,7 @@ EdgeLocalizationSlam::~EdgeLocalizationSlam() {
 }
 
 void EdgeLocalizationSlam::onSlice(MapSlice slice) {
-  const SliceApplyResult applied = applySlice(map_, slice, camera_);
+  const SliceApplyResult applied = applySlice(map_, slice, camera_, options_.sensor);
   if (!applied.keyframes_evicted.empty() || !applied.keyframes_entered.empty()) {
     tracker_->onMapWindowChanged(applied.keyframes_evicted, applied.keyframes_entered);
   }

@@ -165,7 +165,7 @@ void EdgeSlam::applyConfiguration(const KeyframeConfig& config) {
 
 void EdgeSlam::onSlice(MapSlice slice) {
   Stopwatch apply_timer;
-  const SliceApplyResult applied = applySlice(map_, slice, camera_);
+  const SliceApplyResult applied = applySlice(map_, slice, camera_, options_.sensor);
   if (tracker_ && (!applied.keyframes_evicted.empty() || !applied.keyframes_entered.empty())) {
     tracker_->onMapWindowChanged(applied.keyframes_evicted, applied.keyframes_entered);
   }

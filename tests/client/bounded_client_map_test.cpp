@@ -27,7 +27,7 @@ class BoundedClientMap : public ::testing::Test {
   // As the client's slice thread: applySlice takes the map's mutex itself.
   SliceApplyResult apply(const MapSlice& slice) REQUIRES(client_.updateMutex()) {
     test::MutexUnlock unlock(client_.updateMutex());
-    return applySlice(client_, slice, edge_.camera);
+    return applySlice(client_, slice, edge_.camera, Sensor::kRgbd);
   }
 
   MapSlice evicting(std::initializer_list<int> keyframes) {

@@ -43,7 +43,7 @@ TEST(ClientChangeRecord, StaysBoundedWhileTheEdgeCullsWhatTheClientMakes) {
     SliceApplyResult applied;
     {
       test::MutexUnlock unlock(client.updateMutex());  // applySlice takes it
-      applied = applySlice(client, slice, scene.camera());
+      applied = applySlice(client, slice, scene.camera(), Sensor::kRgbd);
     }
     ASSERT_EQ(applied.keyframes_erased, 1u);
     ASSERT_EQ(applied.points_erased, slice.points_erased.size());

@@ -106,7 +106,7 @@ TEST(SliceRoundTrip, SliceCarriesMovesErasuresAndPoseCorrections) {
   SliceApplyResult applied;
   {
     test::MutexUnlock unlock(t.client.updateMutex());  // applySlice takes it
-    applied = applySlice(t.client, slice, t.scene.camera());
+    applied = applySlice(t.client, slice, t.scene.camera(), Sensor::kRgbd);
   }
   EXPECT_EQ(applied.points_erased, 1u);
   EXPECT_EQ(applied.keyframes_moved, 1u);
@@ -132,7 +132,7 @@ TEST(SliceRoundTrip, ObservationsInKeyFramesTheEdgeHasNotSeenSurvive) {
   slice.newest_keyframe = t.edge_keyframes.back()->id();
   {
     test::MutexUnlock unlock(t.client.updateMutex());  // applySlice takes it
-    applySlice(t.client, slice, t.scene.camera());
+    applySlice(t.client, slice, t.scene.camera(), Sensor::kRgbd);
   }
   EXPECT_EQ(replica->observations().size(), before);
   EXPECT_LT((replica->position() - p->position()).norm(), 1e-12);
