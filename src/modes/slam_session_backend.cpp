@@ -96,6 +96,14 @@ void SlamSessionBackend::joinMapping(std::shared_ptr<LiveEdgeMap> live) {
   mapping_ = std::move(live);
   spdlog::info("session {}: joins map '{}', written by {} other client(s) of this server",
                config_.session_id, config_.map_name, mapping_->session->clientCount() - 1);
+  if (options_.store && mapping_->store_writer) {
+    try {
+      joined_store_session_ = options_.store->beginSession(
+          config_.map_name, {config_.client_name, config_.camera, config_.sensor});
+    } catch (const std::exception& e) {
+      spdlog::error("session {}: not recorded in the store: {}", config_.session_id, e.what());
+    }
+  }
 }
 
 SlamSessionBackend::~SlamSessionBackend() {
@@ -103,6 +111,14 @@ SlamSessionBackend::~SlamSessionBackend() {
     // The map goes on while another client writes it; no slice reaches this session once out.
     mapping_->session->removeClient(client_);
     mapping_.reset();
+  }
+  if (joined_store_session_) {
+    try {
+      options_.store->endSession(*joined_store_session_);
+    } catch (const std::exception& e) {
+      spdlog::error("session {}: its end not recorded in the store: {}", config_.session_id,
+                    e.what());
+    }
   }
   if (slices_split_.load() + slices_not_sent_.load() > 0) {
     spdlog::info("session {}: {} slices split to fit a message, {} not sent", config_.session_id,

@@ -80,6 +80,9 @@ class SlamSessionBackend : public EdgeSessionBackend {
   std::unique_ptr<EdgeLocalizationSession> localization_;  // localise-only edge sessions
   std::unique_ptr<LocalSlam> offload_;                     // offload mode, made at the first frame
   std::uint64_t id_floor_ = 0;
+  // A client that joined a map another session writes: its own session in the store, for the
+  // record (who, when; its keyframes are written with the map's writer).
+  std::optional<StoreSessionId> joined_store_session_;
   std::atomic<std::uint64_t> slices_split_{0};     // slices sent as several parts
   std::atomic<std::uint64_t> slices_not_sent_{0};  // slices that could not be sent (logged)
 };

@@ -122,6 +122,12 @@ TEST(SharedMap, TwoClientsMappingOneMapAtOnceEndInOneFrame) {
   EXPECT_NE(server_log.find("joins map 'kitchen'"), std::string::npos) << server_log;
   EXPECT_NE(server_log.find("maps merged"), std::string::npos) << server_log;
 
+  // Each client's session is recorded with the map.
+  const auto info = test::runEdgeslam("map info kitchen --json --maps " + store.string());
+  const auto info_json = nlohmann::json::parse(info.output, nullptr, false);
+  ASSERT_TRUE(info_json.is_object()) << info.output;
+  EXPECT_EQ(info_json.value("sessions", 0), 2) << info.output;
+
   writeJointGroundTruth({work / "first", work / "second"}, work / "halves_truth.tum");
   const StoredMapFigures shared = storedMap(store, "kitchen", work / "halves_truth.tum", work);
   const StoredMapFigures single =
