@@ -369,6 +369,12 @@ void addRunOptions(CLI::App* run, const std::shared_ptr<RunOptions>& options) {
                   "velocity and is searched for there before relocalisation (0 = off)")
       ->check(CLI::Range(0, 300))
       ->capture_default_str();
+  run->add_option("--new-map-after", options->new_map_after_s,
+                  "Lost for S seconds (the camera's time) with relocalisation failing, start a new "
+                  "map beside the old one; loop closing merges them when the camera sees the old "
+                  "places again (0 = wait for relocalisation; in local mode 3 is a good value)")
+      ->check(CLI::Range(0.0, 3600.0))
+      ->capture_default_str();
   auto* max_frames =
       run->add_option("--max-frames", options->max_frames, "Process at most N frames (0 = all)");
   run->add_option("--repeat", options->repeat,
@@ -379,13 +385,15 @@ void addRunOptions(CLI::App* run, const std::shared_ptr<RunOptions>& options) {
       ->capture_default_str();
   run->add_option_function<std::string>(
          "--frames",
-         [options](const std::string& text) { options->frames = parseFrameRange(text); },
+         [options](const std::string& text) { options->frames = parseFrameRanges(text); },
          "Play only frames A-B of the dataset (0-based, inclusive), as if they were the whole "
-         "sequence: one recording standing in for several sessions")
-      ->type_name("A-B")
+         "sequence: one recording standing in for several sessions. Several ranges, "
+         "comma-separated (0-200,375-999), are played one after the other: the camera is "
+         "elsewhere from one frame to the next")
+      ->type_name("A-B[,C-D...]")
       ->check([](const std::string& text) {
         try {
-          (void)parseFrameRange(text);
+          (void)parseFrameRanges(text);
           return std::string();
         } catch (const std::invalid_argument& e) {
           return std::string(e.what());

@@ -10,8 +10,15 @@ nlohmann::json toJson(const PercentileSummary& s) {
   return {{"median", s.median}, {"p90", s.p90}, {"p95", s.p95}, {"p99", s.p99}, {"max", s.max}};
 }
 
-nlohmann::json frameRangeJson(const std::optional<FrameRange>& range, std::size_t played) {
-  return {{"first", range ? range->first : 0}, {"count", played}};
+nlohmann::json frameRangeJson(const std::optional<std::vector<FrameRange>>& ranges,
+                              std::size_t played) {
+  nlohmann::json out = {{"first", ranges ? ranges->front().first : 0}, {"count", played}};
+  if (ranges && ranges->size() > 1) {
+    nlohmann::json list = nlohmann::json::array();
+    for (const FrameRange& r : *ranges) list.push_back({{"first", r.first}, {"last", r.last}});
+    out["ranges"] = list;
+  }
+  return out;
 }
 
 nlohmann::json keyFrameDecisionsJson(const KeyFrameDecisionCounts& c) {

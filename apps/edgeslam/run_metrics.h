@@ -17,7 +17,9 @@ namespace edgeslam::cli {
 
 nlohmann::json toJson(const PercentileSummary& s);
 // "dataset_frames": where the played frames start in the dataset and how many were played.
-nlohmann::json frameRangeJson(const std::optional<FrameRange>& range, std::size_t played);
+// With several ranges, "ranges": [{first, last}, ...] too.
+nlohmann::json frameRangeJson(const std::optional<std::vector<FrameRange>>& ranges,
+                              std::size_t played);
 nlohmann::json keyFrameDecisionsJson(const KeyFrameDecisionCounts& c);
 // ATE of `est` against `gt`; nullopt when there are too few pairs for the alignment.
 std::optional<nlohmann::json> ateJson(const Trajectory& gt, const Trajectory& est, AlignMode align);

@@ -31,8 +31,11 @@ struct RunOptions {
   std::optional<int> segment_refresh_min;  // default: SegmentationRefreshOptions, or the most
   // Lost frames bridged by the motion prediction (TrackerOptions::recover_within_frames).
   std::size_t recover_frames = TrackerOptions{}.recover_within_frames;
-  std::size_t max_frames = 0;        // 0 = all
-  std::optional<FrameRange> frames;  // `--frames A-B`: only these frames of the dataset
+  // Lost this long, a new map is started (TrackerOptions::new_map_after_lost_s; 0 = never).
+  double new_map_after_s = TrackerOptions{}.new_map_after_lost_s;
+  std::size_t max_frames = 0;  // 0 = all
+  // `--frames A-B[,C-D...]`: only these frames of the dataset, the ranges one after the other.
+  std::optional<std::vector<FrameRange>> frames;
   std::size_t repeat = 1;            // `--repeat N`: the frames played N times into one map
   bool realtime = false;             // feed at the dataset's rate (default: as fast as possible)
   bool fast = false;                 // explicit request for the default

@@ -1,6 +1,7 @@
 #include "run_report.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -17,6 +18,14 @@
 #include "tracking_diagnostics_json.h"
 
 namespace edgeslam::cli {
+namespace {
+
+// Maps started after a loss that no merge joined back (each merge joins one; never negative).
+std::size_t unmergedMaps(std::size_t started, std::uint64_t merges) {
+  return started > merges ? started - static_cast<std::size_t>(merges) : 0;
+}
+
+}  // namespace
 
 RunReport::RunReport(const RunSetup& setup, const PlayedFrames& played, const SlamSystem& slam,
                      const RunCompanions& companions, nlohmann::json store_metrics, double wall_s)
@@ -35,21 +44,25 @@ RunReport::RunReport(const RunSetup& setup, const PlayedFrames& played, const Sl
       diagnostics_(slam.trackingDiagnostics()),
       refinement_(slam.intrinsicsRefinement()) {
   const RunOptions& options = setup.options;
-  warnings_ =
-      runWarnings({.frames = setup.frame_count,
-                   .tracked = played.tracked,
-                   .lost = played.lost,
-                   .frames_dropped_late = played.frames_skipped_late,
-                   .backend_busy_refusals = counters_.backend.busy_refusals,
-                   .backend_wait_ms = counters_.backend.wait_total_ms,
-                   .wall_ms = wall_s * 1000.0,
-                   .monocular = setup.sensor == Sensor::kMonocular,
-                   .keyframe_depth_ratio = counters_.map.keyframe_depth_ratio,
-                   .frames_out_of_order = played.frame_order.rejected(),
-                   .frames_without_map = diagnostics_ ? diagnostics_->frames_without_map : 0,
-                   .map_built = !diagnostics_ || diagnostics_->initialized_at_frame.has_value() ||
-                                options.localize_only,
-                   .refusals = diagnostics_ ? refusalSummary(*diagnostics_) : std::string()});
+  warnings_ = runWarnings(
+      {.frames = setup.frame_count,
+       .tracked = played.tracked,
+       .lost = played.lost,
+       .frames_dropped_late = played.frames_skipped_late,
+       .backend_busy_refusals = counters_.backend.busy_refusals,
+       .backend_wait_ms = counters_.backend.wait_total_ms,
+       .wall_ms = wall_s * 1000.0,
+       .monocular = setup.sensor == Sensor::kMonocular,
+       .keyframe_depth_ratio = counters_.map.keyframe_depth_ratio,
+       .frames_out_of_order = played.frame_order.rejected(),
+       .frames_without_map = diagnostics_ ? diagnostics_->frames_without_map : 0,
+       .map_built =
+           !diagnostics_ || diagnostics_->initialized_at_frame.has_value() || options.localize_only,
+       .refusals = diagnostics_ ? refusalSummary(*diagnostics_) : std::string(),
+       // Merges are counted where the back end runs in-process (local mode).
+       .maps_unmerged = options.mode == "local"
+                            ? unmergedMaps(slam.mapsStartedAt().size(), counters_.map.merges)
+                            : 0});
   if (std::string store_warning = storeWarning(store_metrics_, slam.keyFrameCount());
       !store_warning.empty()) {
     warnings_.push_back(std::move(store_warning));
@@ -90,6 +103,8 @@ nlohmann::json RunReport::commonMetrics() const {
           {"tracking_recoveries", slam_.trackingRecoveries()},
           {"keyframe_decisions", keyFrameDecisionsJson(slam_.keyFrameDecisions())},
           {"map_resets", slam_.mapResets()},
+          {"maps_started_at", slam_.mapsStartedAt()},
+          {"map_merges", counters_.map.merges},
           {"tracked_in_discarded_maps", played_.tracked_in_discarded_maps},
           {"mode", options.mode},
           {"requested_mode", options.mode},
@@ -212,6 +227,13 @@ void RunReport::printSummary() const {
       "  map          {} keyframes, {} points, {} relocalisations, {} recoveries, {} resets\n",
       slam_.keyFrameCount(), slam_.mapPointCount(), slam_.relocalizations(),
       slam_.trackingRecoveries(), slam_.mapResets());
+  if (const std::vector<std::size_t> started = slam_.mapsStartedAt(); !started.empty()) {
+    fmt::print("  new maps     {} started after tracking was lost for good (at frames {}), {}\n",
+               started.size(), fmt::join(started, ", "),
+               options.mode == "local"
+                   ? fmt::format("{} merged back by a loop", counters_.map.merges)
+                   : std::string("merges in the edge's log"));
+  }
   if (diagnostics_ && diagnostics_->refusals != decltype(diagnostics_->refusals){}) {
     const std::string refused = refusalSummary(*diagnostics_);
     if (diagnostics_->initialized_at_frame) {

@@ -31,6 +31,7 @@ SlamOptions slamOptionsForRun(const RunOptions& options, const PinholeCamera& ca
   slam_options.orb.validate();
   slam_options.tracker.vocabulary = loadVocabulary(options.vocabulary);
   slam_options.tracker.recover_within_frames = options.recover_frames;
+  slam_options.tracker.new_map_after_lost_s = options.new_map_after_s;
   // The mobile view draws each feature by state; without a viewer nothing is copied.
   slam_options.tracker.report_feature_positions = options.viewer_port.has_value();
   slam_options.backend.vocabulary = slam_options.tracker.vocabulary;

@@ -67,8 +67,10 @@ KeyFrame* MonocularInitializer::tryInitialize(Frame& frame, Map& map) {
 
   KeyFrame* kf0 = nullptr;
   KeyFrame* kf1 = nullptr;
+  bool alone = true;  // the map holds nothing else
   {
     MutexLock lock(map.updateMutex());
+    alone = map.keyFrameCount() == 0;
     kf0 =
         map.createKeyFrame(reference_->index, reference_->timestamp, reference_->features, SE3d());
     kf1 = map.createKeyFrame(frame.index, frame.timestamp, frame.features,
@@ -84,7 +86,15 @@ KeyFrame* MonocularInitializer::tryInitialize(Frame& frame, Map& map) {
     map.updateConnections(kf1);
   }
 
-  globalBundleAdjustment(map, camera_, nullptr, 20);
+  if (alone) {
+    globalBundleAdjustment(map, camera_, nullptr, 20);
+  } else {
+    // Only the two new keyframes and their points, the first held (BA holds the oldest keyframe
+    // of a part without the map's origin).
+    BundleAdjustmentOptions two_view_ba = BundleAdjustmentOptions::global();
+    two_view_ba.first_pass_iterations = 20;
+    localBundleAdjustment(map, kf1, camera_, nullptr, two_view_ba);
+  }
 
   MutexLock lock(map.updateMutex());
   const double median_depth = kf0->medianSceneDepth();
@@ -93,7 +103,13 @@ KeyFrame* MonocularInitializer::tryInitialize(Frame& frame, Map& map) {
     refuse(InitRefusal::kWeakMap,
            fmt::format("initial map too weak ({} points, median depth {:.3f})", tracked,
                        median_depth));
-    map.clear();
+    if (alone) {
+      map.clear();
+    } else {  // the older map stays
+      for (MapPoint* p : kf0->goodPoints()) map.erasePoint(p);
+      map.eraseKeyFrame(kf1);
+      map.eraseKeyFrame(kf0);
+    }
     resetReference(frame);
     return nullptr;
   }
@@ -113,6 +129,7 @@ KeyFrame* MonocularInitializer::tryInitialize(Frame& frame, Map& map) {
   }
   frame.reference_keyframe = kf1;
   reference_.reset();
+  reference_keyframe_ = kf0;
   return kf1;
 }
 

@@ -32,9 +32,13 @@ class MonocularInitializer {
  public:
   MonocularInitializer(const PinholeCamera& camera, MonocularInitializerOptions options = {});
 
-  // Tries to initialise from `frame`; on success the map holds two keyframes and `frame` has its
-  // pose and point matches set. Returns the second keyframe (the current frame's) or nullptr.
+  // Tries to initialise from `frame`; on success the map holds two more keyframes and `frame` has
+  // its pose and point matches set. Returns the second keyframe (the current frame's) or nullptr.
+  // The map may hold an older map already (a new one started after tracking was lost for good):
+  // it is left as it is, and the new keyframes share nothing with it.
   KeyFrame* tryInitialize(Frame& frame, Map& map) EXCLUDES(map.updateMutex());
+  // The first of the two keyframes the last successful tryInitialize made (the reference frame's).
+  KeyFrame* referenceKeyFrame() const { return reference_keyframe_; }
   const std::string& lastFailure() const { return last_failure_; }
   // Why the last call built no map; nullopt when it only waited (a new reference frame).
   std::optional<InitRefusal> lastRefusal() const { return last_refusal_; }
@@ -46,6 +50,7 @@ class MonocularInitializer {
   const PinholeCamera& camera_;
   MonocularInitializerOptions options_;
   std::optional<Frame> reference_;
+  KeyFrame* reference_keyframe_ = nullptr;
   void refuse(InitRefusal refusal, std::string why);
 
   std::string last_failure_;

@@ -26,6 +26,18 @@ SE3d perFrameMotion(const SE3d& motion, std::size_t frames) {
   return SE3d::exp(motion.log() / static_cast<double>(frames));
 }
 
+// A map started after the old one was lost begins where the camera was last tracked: the
+// initialiser's two keyframes and their points (the first keyframe at the origin) move rigidly
+// to that pose, and so does the frame that completed them.
+void placeNewMap(Map& map, KeyFrame& first, KeyFrame& second, const SE3d& start, Frame& frame)
+    REQUIRES(map.updateMutex()) {
+  const SE3d start_inverse = start.inverse();  // initialiser's world -> the map's world
+  for (MapPoint* p : first.goodPoints()) map.relocatePoint(p, start_inverse * p->position());
+  map.setKeyFramePose(&first, first.pose() * start);
+  map.setKeyFramePose(&second, second.pose() * start);
+  if (frame.T_cw) frame.T_cw = *frame.T_cw * start;
+}
+
 }  // namespace
 
 const char* toString(TrackingState state) {
@@ -176,6 +188,7 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
                      frame_index, frames_lost_);
       }
       if (state_ != TrackingState::kOk) frames_lost_ = 0;
+      lost_since_.reset();
       state_ = TrackingState::kOk;
       // The velocity is per frame: over a gap (frames skipped or lost) the motion since the last
       // tracked frame is spread evenly over it, so the next prediction spans its own gap. Not
@@ -199,6 +212,7 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
                             : LostCause::kTrackingFailed);
       state_ = TrackingState::kLost;
       ++frames_lost_;
+      if (!lost_since_) lost_since_ = frame.timestamp;
       if (!canRecoverByPrediction(frame_index + 1)) velocity_.reset();
     }
     for (std::size_t i = 0; i < frame.size(); ++i) {
@@ -217,7 +231,14 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
     std::size_t keyframes = 0;
     {
       MutexLock lock(map_.updateMutex());
-      keyframes = map_.keyFrameCount();
+      keyframes = currentMapKeyFrames();
+    }
+    if (keyframes <= 5 && !maps_started_at_.empty()) {
+      // A map started after an older one was lost: the older stays; another start is tried.
+      startNewMap(frame);
+      record(frame, false);
+      result.state = TrackingState::kLost;
+      return result;
     }
     if (keyframes <= 5) {
       spdlog::warn("map lost with only {} keyframes: starting a new one", keyframes);
@@ -228,6 +249,16 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
       result.state = TrackingState::kLost;
       return result;
     }
+  }
+
+  // Lost for good: relocalisation has failed for the whole of the bound.
+  if (state_ == TrackingState::kLost && lost_since_ && options_.new_map_after_lost_s > 0.0 &&
+      !options_.localization_only &&
+      frame.timestamp - *lost_since_ >= options_.new_map_after_lost_s) {
+    startNewMap(frame);
+    record(frame, false);
+    result.state = TrackingState::kLost;
+    return result;
   }
 
   if (options_.report_feature_positions) reportFeaturePositions(frame, result);
@@ -250,12 +281,13 @@ bool Tracker::initialize(Frame& frame) {
     }
     return false;
   }
-  KeyFrame* kf0 = nullptr;
+  KeyFrame* kf0 = mono_init_.referenceKeyFrame();
   {
     MutexLock lock(map_.updateMutex());
-    kf0 = map_.originKeyFrame();
+    if (new_map_start_pose_) placeNewMap(map_, *kf0, *kf, *new_map_start_pose_, frame);
+    current_map_first_keyframe_ = kf0->id();
     spdlog::info("monocular map initialised at frame {} with {} points (reference frame {})",
-                 frame.index, map_.pointCount(), kf0->frameIndex());
+                 frame.index, kf0->goodPoints().size(), kf0->frameIndex());
     remember(kf0);
     remember(kf);
     reference_keyframe_ = kf;
@@ -267,7 +299,7 @@ bool Tracker::initialize(Frame& frame) {
         r.tracked = true;
         r.reference = kf0;
         r.T_cr = SE3d();
-        r.T_cw = SE3d();
+        r.T_cw = kf0->pose();
       }
     }
   }
@@ -289,29 +321,37 @@ bool Tracker::initializeRgbd(Frame& frame) {
   KeyFrame* kf = nullptr;
   {
     MutexLock lock(map_.updateMutex());
-    frame.T_cw = SE3d();
-    kf = map_.createKeyFrame(frame.index, frame.timestamp, frame.features, SE3d());
+    const SE3d T_cw = new_map_start_pose_.value_or(SE3d());
+    const SE3d T_wc = T_cw.inverse();
+    frame.T_cw = T_cw;
+    kf = map_.createKeyFrame(frame.index, frame.timestamp, frame.features, T_cw);
     const FrameFeatures& f = *frame.features;
+    std::vector<MapPoint*> created;
     for (std::size_t i = 0; i < frame.size(); ++i) {
       if (!f.hasDepth(i)) continue;
       const cv::Point2f& pt = f.keypoints[i].pt;
       const Eigen::Vector3d x = camera_.unproject({pt.x, pt.y}) * f.depth[i];
-      MapPoint* p = map_.createMapPoint(x, kf);
+      MapPoint* p = map_.createMapPoint(T_wc * x, kf);
       map_.addObservation(p, kf, i);
       map_.refreshPoint(p);
       frame.points[i] = p;
+      created.push_back(p);
     }
-    if (map_.pointCount() < 100) {
-      diagnostics_.refuse(
-          InitRefusal::kTooFewDepthPoints,
-          fmt::format("{} keypoints with a valid depth, need 100", map_.pointCount()));
-      map_.clear();
+    if (created.size() < 100) {
+      diagnostics_.refuse(InitRefusal::kTooFewDepthPoints,
+                          fmt::format("{} keypoints with a valid depth, need 100", created.size()));
+      if (maps_started_at_.empty()) {
+        map_.clear();
+      } else {  // the older maps stay
+        for (MapPoint* p : created) map_.erasePoint(p);
+        map_.eraseKeyFrame(kf);
+      }
       frame.T_cw.reset();
       std::fill(frame.points.begin(), frame.points.end(), nullptr);
       return false;
     }
-    spdlog::info("RGB-D map initialised at frame {} with {} points", frame.index,
-                 map_.pointCount());
+    current_map_first_keyframe_ = kf->id();
+    spdlog::info("RGB-D map initialised at frame {} with {} points", frame.index, created.size());
     remember(kf);
   }
   reference_keyframe_ = kf;
@@ -648,6 +688,35 @@ void Tracker::releaseErased() {
                           REQUIRES(map_.updateMutex()) { return map_.keyFrame(id) == nullptr; });
   }
   map_participant_.quiescent(map_);
+}
+
+void Tracker::startNewMap(const Frame& frame) {
+  MutexLock lock(map_.updateMutex());
+  spdlog::warn(
+      "tracking lost since {:.1f} s before frame {} and not relocalised: a new map starts here "
+      "(the old one is kept and merged with it when the camera sees its places again)",
+      lost_since_ ? frame.timestamp - *lost_since_ : 0.0, frame.index);
+  maps_started_at_.push_back(frame.index);
+  if (last_frame_ && last_frame_->T_cw) new_map_start_pose_ = *last_frame_->T_cw;
+  state_ = TrackingState::kNotInitialized;
+  last_frame_.reset();
+  velocity_.reset();
+  reference_keyframe_ = nullptr;
+  local_keyframes_.clear();
+  local_points_.clear();
+  frames_lost_ = 0;
+  lost_since_.reset();
+}
+
+std::size_t Tracker::currentMapKeyFrames() const {
+  std::size_t count = 0;
+  for (const KeyFrame* kf : map_.keyFrames()) {
+    if (!kf->isBad() && idOrigin(kf->id()) == idOrigin(current_map_first_keyframe_) &&
+        kf->id() >= current_map_first_keyframe_) {
+      ++count;
+    }
+  }
+  return count;
 }
 
 void Tracker::resetMap() {

@@ -69,6 +69,13 @@ struct TrackerOptions {
   // Localisation in a map made earlier (Tracker::localizeInMap): no keyframes are made and the map
   // is never reset, so tracking changes nothing in it but its points' seen/found counts.
   bool localization_only = false;
+  // Lost this long (seconds of the camera's time) with relocalisation failing throughout, tracking
+  // starts a new map beside the old one in the same Map: the old keyframes stay, and loop closing
+  // merges the two when the camera sees the old places again (mapping/map_part_merge.h). A camera
+  // that never comes back would otherwise wait for good. 0 = never (wait for relocalisation): the
+  // default, since until a merge (or for good, without one) the new map's poses are in a frame of
+  // their own in the trajectory at frame time.
+  double new_map_after_lost_s = 0.0;
 };
 
 // What triangulating at keyframes did (TrackerOptions::triangulate_at_keyframes).
@@ -126,6 +133,10 @@ class Tracker {
   // Times tracking came back by the motion prediction (TrackerOptions::recover_within_frames).
   std::size_t recoveries() const { return recoveries_; }
   std::size_t resets() const { return resets_; }
+  // New maps started beside the old one after tracking was lost for good
+  // (TrackerOptions::new_map_after_lost_s), and the frames they were started at.
+  std::size_t mapsStarted() const { return maps_started_at_.size(); }
+  const std::vector<std::size_t>& mapsStartedAt() const { return maps_started_at_; }
   // Keyframes made so far, by the rule that made them.
   const KeyFrameDecisionCounts& keyFrameDecisions() const { return keyframe_decisions_; }
   const KeyFrameTriangulationStats& triangulationStats() const { return triangulation_; }
@@ -151,6 +162,11 @@ class Tracker {
   void triangulateAtKeyFrame(KeyFrame* keyframe, Frame& frame) REQUIRES(map_.updateMutex());
   void record(const Frame& frame, bool tracked);
   void resetMap();
+  // Lost for good: the next frames initialise a new map beside the old one (kept, with its
+  // relocalisation database).
+  void startNewMap(const Frame& frame);
+  // Keyframes of the map tracking works in now (the newest part when maps were started).
+  std::size_t currentMapKeyFrames() const REQUIRES(map_.updateMutex());
   // Under the map's mutex, at the start of each frame: lets go of erased points and keyframes so
   // that the map can free them (MapParticipant).
   void releaseErased() REQUIRES(map_.updateMutex());
@@ -180,6 +196,12 @@ class Tracker {
   KeyFrameDecisionCounts keyframe_decisions_;
   std::size_t resets_ = 0;
   std::size_t frames_lost_ = 0;
+  std::optional<double> lost_since_;  // the timestamp of the first frame of the current loss
+  std::vector<std::size_t> maps_started_at_;
+  // The last pose tracked before a new map was started: where the new map begins, so that its
+  // trajectory goes on from there until a merge puts it in the old map's frame.
+  std::optional<SE3d> new_map_start_pose_;
+  KeyFrameId current_map_first_keyframe_ = 0;  // ids below belong to older maps
   KeyFrameTriangulationStats triangulation_;
   TrackingDiagnostics diagnostics_;
 };

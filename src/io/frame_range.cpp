@@ -61,4 +61,51 @@ std::unique_ptr<DatasetReader> selectFrames(std::unique_ptr<DatasetReader> reade
                                            fmt::format("a {}-frame range", range.count()));
 }
 
+std::vector<FrameRange> parseFrameRanges(const std::string& text) {
+  std::vector<FrameRange> ranges;
+  std::size_t start = 0;
+  while (true) {
+    const std::size_t comma = text.find(',', start);
+    const std::string part =
+        text.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    try {
+      ranges.push_back(parseFrameRange(part));
+    } catch (const std::invalid_argument&) {
+      throw std::invalid_argument(fmt::format(
+          "bad frame ranges '{}': expected A-B or several, comma-separated (0-200,375-999)", text));
+    }
+    if (comma == std::string::npos) break;
+    start = comma + 1;
+  }
+  return ranges;
+}
+
+std::unique_ptr<DatasetReader> selectFrames(std::unique_ptr<DatasetReader> reader,
+                                            const std::vector<FrameRange>& ranges) {
+  if (ranges.empty()) throw std::invalid_argument("no frame range to play");
+  if (ranges.size() == 1) return selectFrames(std::move(reader), ranges.front());
+  const std::size_t frame_count = reader->info().frame_count;
+  const std::vector<double>& stamps = reader->timestamps();
+  double interval = reader->info().fps > 0.0 ? 1.0 / reader->info().fps : 1.0 / 30.0;
+  if (stamps.size() >= 2) {
+    interval = (stamps.back() - stamps.front()) / static_cast<double>(stamps.size() - 1);
+  }
+  std::vector<std::size_t> inner_index;
+  std::vector<double> timestamps;
+  for (const FrameRange& range : ranges) {
+    checkFrameRange(range, frame_count);
+    // The first range keeps its times; a next one starts one interval after the previous end.
+    const double shift =
+        timestamps.empty() ? 0.0 : timestamps.back() + interval - stamps[range.first];
+    for (std::size_t k = range.first; k <= range.last; ++k) {
+      inner_index.push_back(k);
+      timestamps.push_back(stamps[k] + shift);
+    }
+  }
+  const std::size_t total = inner_index.size();
+  return std::make_unique<ReindexedReader>(
+      std::move(reader), std::move(inner_index), std::move(timestamps),
+      fmt::format("{} frames in {} ranges", total, ranges.size()));
+}
+
 }  // namespace edgeslam

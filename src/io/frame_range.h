@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "io/dataset.h"
 
@@ -26,5 +27,16 @@ void checkFrameRange(const FrameRange& range, std::size_t frame_count);
 // truth and file names. Throws std::invalid_argument (checkFrameRange) when they do not fit.
 std::unique_ptr<DatasetReader> selectFrames(std::unique_ptr<DatasetReader> reader,
                                             const FrameRange& range);
+
+// "A-B" or several such ranges, comma-separated ("0-200,375-999"). Throws std::invalid_argument
+// quoting the text.
+std::vector<FrameRange> parseFrameRanges(const std::string& text);
+
+// Several stretches played one after the other as one sequence: a cut between two is a camera
+// that is elsewhere from one frame to the next (kidnapped). The first keeps its timestamps; each
+// next one follows the previous one's last frame by one frame interval (its own intervals kept),
+// so time always goes on. One range: as above.
+std::unique_ptr<DatasetReader> selectFrames(std::unique_ptr<DatasetReader> reader,
+                                            const std::vector<FrameRange>& ranges);
 
 }  // namespace edgeslam

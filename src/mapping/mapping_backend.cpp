@@ -241,6 +241,11 @@ std::optional<std::string> MappingBackend::failure() const {
 MappingBackendCounters MappingBackend::counters() const {
   MappingBackendCounters out;
   out.loops = loops();
+  if (loop_closer_) {
+    for (const LoopEvent& event : loop_closer_->stats().events) {
+      if (event.keyframes_merged > 0) ++out.merges;
+    }
+  }
   out.keyframes_segmented = keyframes_segmented_.load();
   out.movable_points_erased = movable_points_erased_.load();
   if (segmentation_) out.segmentation_ms = segmentation_->counters().segmentation_ms;

@@ -72,6 +72,7 @@ struct MappingBackendHooks {
 
 struct MappingBackendCounters {
   std::uint64_t loops = 0;
+  std::uint64_t merges = 0;  // of those, loops that joined two parts of the map
   std::uint64_t keyframes_segmented = 0;
   std::uint64_t movable_points_erased = 0;
   PercentileSummary segmentation_ms;

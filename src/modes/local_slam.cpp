@@ -68,6 +68,7 @@ SlamCounters LocalSlam::counters() const {
   SlamCounters out;
   const MappingBackendCounters backend = backend_->counters();
   out.map.loops = backend.loops;
+  out.map.merges = backend.merges;
   addClientCounters(out);
   if (backend_->segments()) {
     out.semantic.keyframes_segmented = backend.keyframes_segmented;

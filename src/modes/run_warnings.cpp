@@ -49,6 +49,12 @@ std::vector<std::string> runWarnings(const RunHealth& h, const RunWarningThresho
                               h.frames_without_map, processed,
                               h.refusals.empty() ? "no usable frame" : h.refusals));
   }
+  if (h.maps_unmerged > 0) {
+    out.push_back(fmt::format(
+        "{} map(s) started after tracking was lost for good never met the first again: the "
+        "poses tracked in them are in a frame of their own",
+        h.maps_unmerged));
+  }
   if (h.monocular && h.keyframe_depth_ratio > 0.0 &&
       (h.keyframe_depth_ratio > t.max_depth_ratio ||
        h.keyframe_depth_ratio < 1.0 / t.max_depth_ratio)) {

@@ -22,6 +22,9 @@ struct RunHealth {
   std::size_t frames_without_map = 0;   // processed before the first map (or after a reset)
   bool map_built = true;
   std::string refusals = {};  // initialisation refusals by cause, most frequent first ("" = none)
+  // Maps started after tracking was lost for good that no loop merged back (each keeps a frame of
+  // its own: one alignment does not fit the whole trajectory).
+  std::size_t maps_unmerged = 0;
 };
 
 struct RunWarningThresholds {

@@ -47,6 +47,9 @@ struct ClientStageSummary {
 // What the map went through.
 struct MapCounters {
   std::uint64_t loops = 0;
+  // Loops that joined two parts of the map (a map started after tracking was lost for good, met
+  // again); counted where the back end runs in-process (local mode).
+  std::uint64_t merges = 0;
   // Monocular: median scene depth of the last quarter of the keyframes over that of the first
   // quarter (0 when there are too few keyframes). Along a drive the scene's depth stays about the
   // same, so a map whose scale drifts shows it here (a cheap hint, no ground truth needed).

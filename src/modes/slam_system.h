@@ -139,6 +139,8 @@ class SlamSystem {
   // Why frames had no map or were lost, per cause (nullopt where the client does not track).
   virtual std::optional<TrackingDiagnostics> trackingDiagnostics() const { return std::nullopt; }
   virtual std::size_t mapResets() const = 0;
+  // Frames at which a new map was started beside the old one, tracking lost for good.
+  virtual std::vector<std::size_t> mapsStartedAt() const { return {}; }
   // The last frame's semantic stage (mask, culled features); nullptr where the client does not
   // track (offload).
   virtual const SemanticFrame* lastSemanticFrame() const { return nullptr; }
@@ -175,6 +177,7 @@ class TrackingSlam : public SlamSystem {
     return tracker_->diagnostics();
   }
   std::size_t mapResets() const override { return tracker_->resets(); }
+  std::vector<std::size_t> mapsStartedAt() const override { return tracker_->mapsStartedAt(); }
   // Always present: without semantic culling, every feature is kept and there is no mask.
   const SemanticFrame* lastSemanticFrame() const override { return &last_semantic_; }
   ClientStageTimes lastFrameStages() const override { return last_stages_; }

@@ -27,6 +27,19 @@ TEST(FrameRange, RejectsMalformedText) {
   }
 }
 
+TEST(FrameRange, ParsesSeveralRanges) {
+  const std::vector<FrameRange> ranges = parseFrameRanges("0-200,375-999");
+  ASSERT_EQ(ranges.size(), 2u);
+  EXPECT_EQ(ranges[0].first, 0u);
+  EXPECT_EQ(ranges[0].last, 200u);
+  EXPECT_EQ(ranges[1].first, 375u);
+  EXPECT_EQ(ranges[1].last, 999u);
+  EXPECT_EQ(parseFrameRanges("5-9").size(), 1u);
+  for (const char* text : {"", ",", "0-10,", ",0-10", "0-10,,20-30", "0-10;20-30", "0-10,30-20"}) {
+    EXPECT_THROW(parseFrameRanges(text), std::invalid_argument) << text;
+  }
+}
+
 TEST(FrameRange, CheckAgainstSequenceLength) {
   EXPECT_NO_THROW(checkFrameRange({0, 99}, 100));
   EXPECT_THROW(checkFrameRange({0, 100}, 100), std::invalid_argument);

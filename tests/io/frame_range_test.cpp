@@ -50,5 +50,29 @@ TEST(FrameRange, RefusesARangeOutsideTheDataset) {
   EXPECT_EQ(all->info().frame_count, 1000u);
 }
 
+// `--frames 0-200,375-999`: two stretches as one sequence, the camera kidnapped between them.
+TEST(FrameRange, SeveralRangesPlayOneAfterTheOtherWithTimeGoingOn) {
+  EDGESLAM_REQUIRE_SHARED(kSevenScenes);
+  const auto folder = test::sharedPath(kSevenScenes);
+  auto whole = openDataset(folder);
+  auto cut = selectFrames(openDataset(folder), parseFrameRanges("100-109,500-504,20-21"));
+  ASSERT_EQ(cut->info().frame_count, 17u);
+  const std::vector<double>& t = cut->timestamps();
+  EXPECT_EQ(t[0], whole->timestamps()[100]);
+  EXPECT_EQ(t[9], whole->timestamps()[109]);
+  const double interval = whole->timestamps()[1] - whole->timestamps()[0];
+  for (std::size_t i = 1; i < t.size(); ++i) EXPECT_NEAR(t[i] - t[i - 1], interval, 1e-6) << i;
+  ASSERT_TRUE(cut->groundTruth()[10].has_value());
+  EXPECT_TRUE(
+      cut->groundTruth()[10]->translation().isApprox(whole->groundTruth()[500]->translation()));
+  EXPECT_TRUE(
+      cut->groundTruth()[16]->translation().isApprox(whole->groundTruth()[21]->translation()));
+  const DatasetFrame frame = cut->load(15);
+  EXPECT_EQ(frame.name, whole->load(20).name);
+  EXPECT_EQ(frame.timestamp, t[15]);
+  EXPECT_THROW((void)selectFrames(openDataset(folder), parseFrameRanges("0-10,995-1000")),
+               std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace edgeslam

@@ -23,6 +23,15 @@ TEST(RunWarnings, NameWhatMadeTheRunWorse) {
   EXPECT_NE(warnings[4].find("scale drift"), std::string::npos) << warnings[4];
 }
 
+TEST(RunWarnings, SayWhenAMapStartedAfterALossWasNeverMergedBack) {
+  RunHealth health{.frames = 826, .tracked = 734, .lost = 70};
+  health.maps_unmerged = 1;
+  const auto warnings = runWarnings(health);
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("1 map(s) started after tracking was lost"), std::string::npos)
+      << warnings[0];
+}
+
 TEST(RunWarnings, NoneForAHealthyRun) {
   const RunHealth health{.frames = 400,
                          .tracked = 398,
