@@ -25,8 +25,8 @@ nlohmann::json runCut(const fs::path& out, const std::string& vocabulary,
                       const std::string& extra) {
   const auto r = test::runEdgeslam("run --dataset " + test::sharedPath(kKitchen).string() +
                                    " --frames 0-200,375-999 --sensor rgbd --mode local --maps none"
-                                   " --deterministic --vocab " + vocabulary +
-                                   " --out " + out.string() + extra);
+                                   " --deterministic --vocab " +
+                                   vocabulary + " --out " + out.string() + extra);
   EXPECT_EQ(r.exit_code, 0) << r.output;
   std::ifstream in(out / "metrics.json");
   if (!in) return {};
