@@ -698,6 +698,10 @@ void Tracker::startNewMap(const Frame& frame) {
       lost_since_ ? frame.timestamp - *lost_since_ : 0.0, frame.index);
   maps_started_at_.push_back(frame.index);
   if (last_frame_ && last_frame_->T_cw) new_map_start_pose_ = *last_frame_->T_cw;
+  forgetTrackingState();
+}
+
+void Tracker::forgetTrackingState() {
   state_ = TrackingState::kNotInitialized;
   last_frame_.reset();
   velocity_.reset();
@@ -727,13 +731,7 @@ void Tracker::resetMap() {
     r.tracked = false;
     r.reference = nullptr;
   }
-  state_ = TrackingState::kNotInitialized;
-  last_frame_.reset();
-  velocity_.reset();
-  reference_keyframe_ = nullptr;
-  local_keyframes_.clear();
-  local_points_.clear();
-  frames_lost_ = 0;
+  forgetTrackingState();
   ++resets_;
   map_participant_.quiescent(map_);  // nothing of the old map is held any more
 }

@@ -165,6 +165,9 @@ class Tracker {
   // Lost for good: the next frames initialise a new map beside the old one (kept, with its
   // relocalisation database).
   void startNewMap(const Frame& frame);
+  // Tracking starts again from no map: state, last frame, motion, reference keyframe, local map
+  // and the loss clock forgotten (the map itself is the caller's).
+  void forgetTrackingState();
   // Keyframes of the map tracking works in now (the newest part when maps were started).
   std::size_t currentMapKeyFrames() const REQUIRES(map_.updateMutex());
   // Under the map's mutex, at the start of each frame: lets go of erased points and keyframes so
