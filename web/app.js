@@ -2,8 +2,10 @@
 // with orbit controls, the figures in a table and a uPlot chart. One page for both views:
 //   mobile (`run --viewer`): the client's camera image with its features and mask, its map, its
 //                            pose and figures;
-//   edge (`server --viewer`): every session's map, trajectory and live position, per-client
-//                            figures, sessions joining and leaving, loop closures.
+//   edge (`server --viewer`): every map the server holds (live and stored); for the chosen one
+//                            its points, keyframes, each client's trajectory and live position,
+//                            loops and merges, routes; per-client figures; sessions joining and
+//                            leaving, loops closed and maps merged.
 import * as THREE from 'three';
 import { OrbitControls } from './lib/OrbitControls.js';
 
@@ -13,6 +15,10 @@ const COLORS = {
   truth: 0xf0a53c,
   keyframe: 0x5a9cff,
   camera: 0xff5a5a,
+  loop: 0xffe14d,
+  merge: 0xff4dd2,
+  route: 0x4de3ff,
+  earlier: 0x8b95a3,  // a stored map's keyframes made by clients no longer connected
 };
 // One colour per edge session, by session id.
 const CLIENT_COLORS = [0x5ad17a, 0x5a9cff, 0xf0a53c, 0xd36bff, 0x3fd0d4, 0xff7a9c, 0xc8d14a];
@@ -27,7 +33,8 @@ const css = (hex) => '#' + hex.toString(16).padStart(6, '0');
 
 // What the browser test reads (tests/browser/viewer_test.mjs).
 const progress = { messages: 0, view: null, connected: false, reconnects: 0, points: 0,
-  frames_loaded: 0, sessions: 0, last_version: 0 };
+  frames_loaded: 0, sessions: 0, last_version: 0, maps: 0, map_shown: null, map_live: null,
+  map_clients: 0, stored_points: 0, loops: 0, merges: 0, route_checkpoints: 0 };
 window.edgeslamViewer = progress;
 
 // --- the 3D scene ---------------------------------------------------------------------------
@@ -87,6 +94,35 @@ const trajectoryGroup = new THREE.Group();  // one line per trajectory (per clie
 scene.add(trajectoryGroup);
 const cameraGroup = new THREE.Group();  // live camera(s)
 scene.add(cameraGroup);
+
+// Loops and merges on the edge view: a segment between the two keyframes of each (short: they see
+// one place) and a large dot on each end.
+const loopLines = new THREE.LineSegments(dynamicGeometry(), new THREE.LineBasicMaterial({ color: COLORS.loop }));
+const mergeLines = new THREE.LineSegments(dynamicGeometry(), new THREE.LineBasicMaterial({ color: COLORS.merge }));
+const loopDots = new THREE.Points(dynamicGeometry(),
+  new THREE.PointsMaterial({ color: COLORS.loop, size: 12, sizeAttenuation: false }));
+const mergeDots = new THREE.Points(dynamicGeometry(),
+  new THREE.PointsMaterial({ color: COLORS.merge, size: 14, sizeAttenuation: false }));
+scene.add(loopLines, mergeLines, loopDots, mergeDots);
+// The checkpoints of routes: a line through them and a dot on each.
+const routeLine = new THREE.LineSegments(dynamicGeometry(), new THREE.LineBasicMaterial({ color: COLORS.route }));
+const routePoints = new THREE.Points(dynamicGeometry(),
+  new THREE.PointsMaterial({ color: COLORS.route, size: 7, sizeAttenuation: false }));
+const nextCheckpoint = new THREE.Points(dynamicGeometry(),
+  new THREE.PointsMaterial({ color: COLORS.camera, size: 11, sizeAttenuation: false }));
+scene.add(routeLine, routePoints, nextCheckpoint);
+
+function showRoutes(routes, next = -1) {
+  const segments = [], dots = [], highlight = [];
+  for (const checkpoints of routes) {
+    for (let i = 0; i + 5 < checkpoints.length; i += 3) segments.push(...checkpoints.slice(i, i + 6));
+    dots.push(...checkpoints);
+    if (next >= 0 && 3 * next + 2 < checkpoints.length) highlight.push(...checkpoints.slice(3 * next, 3 * next + 3));
+  }
+  setPositions(routeLine.geometry, segments);
+  setPositions(routePoints.geometry, dots);
+  setPositions(nextCheckpoint.geometry, highlight);
+}
 
 // A camera as a pyramid: apex at its centre, base `size` ahead; 16 line-segment ends (SLAM frame).
 const FRUSTUM = [[-0.6, -0.45], [0.6, -0.45], [0.6, 0.45], [-0.6, 0.45]];
@@ -153,6 +189,8 @@ window.addEventListener('resize', resize);
 resize();
 
 controls.addEventListener('change', requestRender);
+let userMoved = false;  // the user dragged or zoomed: the edge view no longer frames itself
+controls.addEventListener('start', () => { userMoved = true; });
 function animate() {
   if (follow && followTarget) {
     const shift = followTarget.clone().sub(controls.target);
@@ -282,7 +320,7 @@ function showMobile(snapshot, first) {
     document.getElementById('view-name').textContent = '\u00b7 mobile';
     makeChart('client / end-to-end ms', [['client ms', COLORS.camera], ['e2e ms', COLORS.keyframe]]);
     setLegend([[COLORS.camera, 'camera'], [COLORS.trajectory, 'trajectory'],
-      [COLORS.keyframe, 'keyframes'], [COLORS.truth, 'ground truth']]);
+      [COLORS.keyframe, 'keyframes'], [COLORS.truth, 'ground truth'], [COLORS.route, 'route']]);
     pollFrame();
   }
   const rows = [
@@ -302,6 +340,8 @@ function showMobile(snapshot, first) {
     ['adaptation row', s.adaptation_row >= 0 ? s.adaptation_row + 1 : '-'],
   ];
   if (s.instruction) rows.push(['instruction', s.instruction]);
+  const route = snapshot.route ?? [];
+  if (route.length) rows.push(['checkpoint', s.checkpoint >= 0 ? `${s.checkpoint + 1} / ${route.length / 3}` : '-']);
   showRows(rows);
   addChartSample(s.frame, [s.client_ms, s.e2e_ms ?? null]);
 
@@ -313,6 +353,8 @@ function showMobile(snapshot, first) {
   setPositions(keyframeLines.geometry, flat);
   clearGroup(trajectoryGroup);
   addTrajectory(snapshot.trajectory, COLORS.trajectory);
+  showRoutes(route.length ? [route] : [], s.checkpoint);
+  progress.route_checkpoints = route.length / 3;
   clearGroup(cameraGroup);
   if (snapshot.camera) {
     cameraGroup.add(cameraMesh(snapshot.camera, 2 * size, COLORS.camera));
@@ -323,47 +365,85 @@ function showMobile(snapshot, first) {
   requestRender();
 }
 
-// --- the edge view: every session the server holds ---------------------------------------------
+// --- the edge view: every map the server holds ------------------------------------------------
 
-const sessionSelect = document.getElementById('session');
-let chosenSession = 'all';
-sessionSelect.addEventListener('change', () => { chosenSession = sessionSelect.value; fitPending = true; });
+const mapSelect = document.getElementById('map-choice');
+let chosenMap = null;  // a map's name; null: the first live map (or the first stored one)
 let fitPending = true;
+let storedShown = null;  // { name, map } of the stored map on show, fetched from api/map
+mapSelect.addEventListener('change', () => {
+  chosenMap = mapSelect.value;
+  fitPending = true;
+  if (latest) showEdge(latest, false);
+});
+
+async function fetchStoredMap(name) {
+  if (storedShown && storedShown.name === name) return;
+  storedShown = { name, map: null };
+  try {
+    const response = await fetch('api/map?name=' + encodeURIComponent(name));
+    if (!response.ok) throw new Error(await response.text());
+    const map = await response.json();
+    if (storedShown && storedShown.name === name) storedShown.map = map;
+    progress.stored_points = map.points.length / 3;
+  } catch (e) {
+    setConnection(false, `map '${name}' could not be read: ${e.message}`);
+  }
+  if (latest) showEdge(latest, false);
+}
+
+function mapLabel(m) {
+  if (m.live) {
+    const n = m.sessions.length;
+    return `${m.name} \u00b7 live, ${n} client${n === 1 ? '' : 's'}${m.localize_only ? ', localising' : ''}`;
+  }
+  return `${m.name} \u00b7 stored, ${m.keyframe_count} keyframes`;
+}
 
 function showEdge(snapshot, first) {
   if (first) {
     document.getElementById('view-name').textContent = '\u00b7 edge';
-    document.getElementById('session-picker').hidden = false;
+    document.getElementById('map-picker').hidden = false;
     document.getElementById('events').hidden = false;
     makeChart('keyframes per client', CLIENT_COLORS.slice(0, 4).map((c, i) => [`client ${i + 1}`, c]), 'update');
-    setLegend([[COLORS.keyframe, 'keyframes'], [COLORS.camera, 'live position'], [COLORS.point, 'map points']]);
+    setLegend([[COLORS.keyframe, 'keyframes'], [COLORS.point, 'map points'], [COLORS.loop, 'loop'],
+      [COLORS.merge, 'merge'], [COLORS.route, 'route']]);
     setFollow(false);
   }
+  const maps = snapshot.maps;
   const sessions = snapshot.sessions;
-  // The picker: "all" and one entry per session, kept in step with the server's list.
-  const options = ['all', ...sessions.map((s) => String(s.session_id))];
-  if ([...sessionSelect.options].map((o) => o.value).join() !== options.join()) {
-    sessionSelect.innerHTML = '';
-    for (const value of options) {
-      const s = sessions.find((x) => String(x.session_id) === value);
-      sessionSelect.add(new Option(s ? `client ${clientNumber(value)} \u00b7 ${s.client_name}` : 'all maps', value));
-    }
-    if (!options.includes(chosenSession)) chosenSession = 'all';
-    sessionSelect.value = chosenSession;
+  // The picker: one entry per map, live ones first, kept in step with the server's list.
+  const labels = maps.map(mapLabel);
+  if ([...mapSelect.options].map((o) => o.text).join('|') !== labels.join('|')) {
+    mapSelect.innerHTML = '';
+    maps.forEach((m, i) => mapSelect.add(new Option(labels[i], m.name)));
   }
-  const shown = sessions.filter((s) => chosenSession === 'all' || String(s.session_id) === chosenSession);
+  let shownName = chosenMap;
+  if (!maps.some((m) => m.name === shownName)) shownName = maps.length ? maps[0].name : null;
+  mapSelect.value = shownName ?? '';
+  const listed = maps.find((m) => m.name === shownName);
+  let map = listed && listed.live ? listed : null;
+  if (listed && !listed.live) {
+    fetchStoredMap(listed.name);
+    if (storedShown && storedShown.name === listed.name) map = storedShown.map;
+  }
 
-  const rows = [['sessions', `${sessions.length} (${snapshot.status.sessions_opened} opened)`],
-    ['loop closures', snapshot.status.loops]];
+  const rows = [['maps', `${maps.length} (${maps.filter((m) => m.live).length} live)`],
+    ['sessions', `${sessions.length} (${snapshot.status.sessions_opened} opened)`],
+    ['loops / merges', `${snapshot.status.loops} / ${snapshot.status.merges}`]];
+  if (map) {
+    const stored = map.stored ? `, stored ${formatBytes(map.stored.bytes)}` : '';
+    rows.push([`map ${map.name}`, `${map.keyframe_count} kf, ${map.map_points} pts${stored}`]);
+  }
   for (const s of sessions) {
     rows.push([`\u25cf client ${clientNumber(s.session_id)} \u00b7 ${s.client_name} (${s.sensor})`]);
-    rows.push(['keyframes / points', `${s.keyframe_count} / ${s.map_points}`]);
-    rows.push(['loops closed', s.loops]);
+    rows.push(['map', s.map ?? '-']);
+    rows.push(['keyframes', s.keyframe_count]);
     rows.push(['bytes up / down', `${formatBytes(s.uplink_bytes)} / ${formatBytes(s.downlink_bytes)}`]);
     rows.push(['position', formatPosition(s.camera)]);
   }
   showRows(rows);
-  // Colour the session headings like their trajectories.
+  // Colour the client headings like their trajectories.
   let heading = 0;
   for (const tr of statsTable.rows) {
     if (tr.className === 'client') tr.cells[0].style.color = css(clientColor(sessions[heading++].session_id));
@@ -378,29 +458,48 @@ function showEdge(snapshot, first) {
   for (const e of snapshot.events.slice(-12).reverse()) {
     const li = document.createElement('li');
     li.textContent = `${e.time} ${e.text}`;
+    if (/merged/.test(e.text)) li.className = 'merge';
+    else if (/loop closed/.test(e.text)) li.className = 'loop';
     events.appendChild(li);
   }
 
-  const points = [], keyframes = [], all = [];
-  const size = 0.02 * sceneSize;
   clearGroup(trajectoryGroup);
   clearGroup(cameraGroup);
-  for (const s of shown) {
-    points.push(...s.points);
-    for (const kf of s.keyframes) frustumSegments(kf, size, keyframes);
-    addTrajectory(s.trajectory, clientColor(s.session_id));
-    all.push(...s.trajectory);
+  const size = 0.02 * sceneSize;
+  const keyframes = [], loops = [], merges = [];
+  // A trajectory per client: the session whose keyframes carry that id origin, or an earlier one.
+  const inMap = sessions.filter((s) => map && s.map === map.name);
+  for (const t of map ? map.trajectories : []) {
+    const owner = inMap.find((s) => s.origin === t.origin);
+    addTrajectory(t.positions, owner ? clientColor(owner.session_id) : COLORS.earlier);
+  }
+  for (const kf of map ? map.keyframes : []) frustumSegments(kf, size, keyframes);
+  for (const l of map ? map.loops : []) (l.merge ? merges : loops).push(...l.from, ...l.to);
+  for (const s of inMap) {
     if (s.camera) cameraGroup.add(cameraMesh(s.camera, 2.5 * size, clientColor(s.session_id)));
   }
-  setPositions(pointCloud.geometry, points);
+  setPositions(pointCloud.geometry, map ? map.points : []);
   setPositions(keyframeLines.geometry, keyframes);
+  setPositions(loopLines.geometry, loops);
+  setPositions(mergeLines.geometry, merges);
+  setPositions(loopDots.geometry, loops);
+  setPositions(mergeDots.geometry, merges);
   setPositions(truthLine.geometry, []);
-  if (fitPending && all.length >= 6) {
+  showRoutes(map ? map.routes.map((r) => r.checkpoints) : []);
+  const all = map ? map.trajectories.flatMap((t) => t.positions) : [];
+  // Framed as the map grows, until the user moves the view ("fit" frames it again).
+  if ((fitPending || !userMoved) && all.length >= 6) {
     fitView(all);
     fitPending = false;
   }
-  progress.points = points.length / 3;
+  progress.points = map ? map.points.length / 3 : 0;
   progress.sessions = sessions.length;
+  progress.maps = maps.length;
+  progress.map_shown = map ? map.name : null;
+  progress.map_live = map ? map.live : null;
+  progress.map_clients = map ? map.trajectories.length : 0;
+  progress.loops = snapshot.status.loops;
+  progress.merges = snapshot.status.merges;
   requestRender();
 }
 
@@ -446,6 +545,7 @@ function setFollow(on) {
 }
 document.getElementById('follow').addEventListener('change', (e) => { follow = e.target.checked; });
 document.getElementById('top-view').addEventListener('click', () => {
+  userMoved = true;
   const distance = camera3d.position.distanceTo(controls.target);
   camera3d.position.copy(controls.target).add(new THREE.Vector3(0, distance, 0.001));
   requestRender();
@@ -453,7 +553,12 @@ document.getElementById('top-view').addEventListener('click', () => {
 document.getElementById('fit').addEventListener('click', () => {
   setFollow(false);
   if (!latest) return;
-  fitView(latest.view === 'edge' ? latest.sessions.flatMap((s) => s.trajectory) : latest.trajectory);
+  if (latest.view !== 'edge') {
+    fitView(latest.trajectory);
+  } else {
+    userMoved = false;
+    showEdge(latest, false);
+  }
 });
 
 connect();

@@ -55,6 +55,11 @@ std::string RouteFollowing::lastText() const {
   return last().text(navigator_->route().checkpoints.size());
 }
 
+int RouteFollowing::lastCheckpoint() const {
+  if (instructions_.empty() || last().kind == InstructionKind::kNoPose) return -1;
+  return static_cast<int>(last().checkpoint);
+}
+
 void RouteFollowing::writeInstructions(const std::filesystem::path& path) const {
   std::ofstream out(path);
   if (!out) throw std::runtime_error(path.string() + ": cannot be written");

@@ -32,6 +32,11 @@ class RouteFollowing {
   const Instruction& addFrame(std::size_t frame, double timestamp, const std::optional<SE3d>& T_cw);
   const Instruction& last() const { return instructions_.back().instruction; }
   std::string lastText() const;
+  // The checkpoint the latest instruction leads to or reached (0-based); -1 before any.
+  int lastCheckpoint() const;
+  const std::vector<Eigen::Vector3d>& checkpoints() const {
+    return navigator_->route().checkpoints;
+  }
 
   // instructions.csv: frame,timestamp,instruction,checkpoint,turn_deg,distance_m,text.
   void writeInstructions(const std::filesystem::path& path) const;

@@ -289,6 +289,7 @@ int runPipeline(const RunOptions& given) {
     route.emplace(
         storeDirectory(options.maps), options.map_name, options.route,
         RouteFollowingOptions{.success_radius_m = options.checkpoint_radius_m, .navigator = {}});
+    if (viewer) viewer->view().setRoute(route->checkpoints());
   }
   RunCompanions companions{.viewer = viewer.get(),
                            .view_status = {.frames_total = input.frame_count,

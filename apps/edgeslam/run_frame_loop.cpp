@@ -68,7 +68,10 @@ void publishToViewer(RunCompanions& companions, const FrameLogEntry& logged, dou
   status.client_ms = logged.client_ms;
   status.e2e_ms = logged.e2e_ms;
   status.adaptation_row = logged.adaptation_row;
-  if (companions.route) status.instruction = companions.route->lastText();
+  if (companions.route) {
+    status.instruction = companions.route->lastText();
+    status.checkpoint = companions.route->lastCheckpoint();
+  }
   status.uplink_bytes = logged.uplink_bytes;
   status.downlink_bytes = logged.downlink_bytes;
   const std::optional<SE3d> camera =

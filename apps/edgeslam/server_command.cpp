@@ -74,7 +74,10 @@ int runServer(const ServerOptions& o) {
   const std::string& listen = o.listen;
   const int status_interval_s = o.status_interval_s;
   std::shared_ptr<EdgeSessionFactory> factory = std::make_shared<SlamSessionFactory>(options);
-  if (viewer) factory = viewer->wrap(std::move(factory));
+  if (viewer) {
+    factory = viewer->wrap(std::move(factory));
+    if (store.store) viewer->showStore(store.store);
+  }
   EdgeServerLimits limits = serverLimits(o.security);
   limits.idle_timeout = std::chrono::seconds(o.idle_timeout_s);
   EdgeServer server(listen, std::move(factory), limits, std::move(security));

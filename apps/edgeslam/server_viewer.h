@@ -35,6 +35,8 @@ class ServerViewer {
     viz::EdgeView* view_;
   };
   [[nodiscard]] std::unique_ptr<Attachment> attach(const EdgeServer& server);
+  // The maps of the server's store, listed and shown on request.
+  void showStore(std::shared_ptr<MapStore> store) { view_.setStore(std::move(store)); }
 
  private:
   std::shared_ptr<viz::SessionDirectory> directory_;

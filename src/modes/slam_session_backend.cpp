@@ -43,7 +43,9 @@ MapSample sampleOf(const Map& map, std::size_t max_points) {
   MapSample sample;
   MutexLock lock(map.updateMutex());
   for (const KeyFrame* kf : map.keyFrames()) {
-    if (!kf->isBad()) sample.keyframe_poses.push_back(kf->poseInverse());
+    if (kf->isBad()) continue;
+    sample.keyframe_poses.push_back(kf->poseInverse());
+    sample.keyframe_ids.push_back(kf->id());
   }
   sample.points = map.pointPositionSample(max_points);
   sample.total_points = map.pointCount();
@@ -55,7 +57,14 @@ MapSample sampleOf(const Map& map, std::size_t max_points) {
 SlamSessionBackend::SlamSessionBackend(const SessionConfig& config, SliceSink& sink,
                                        SlamSessionOptions options,
                                        std::shared_ptr<LiveEdgeMaps> live_maps)
-    : config_(config), sink_(sink), options_(options), live_maps_(std::move(live_maps)) {
+    : config_(config),
+      store_map_name_(
+          !config.map_name.empty() || !options.store
+              ? config.map_name
+              : defaultMapName(config.client_name + "-s" + std::to_string(config.session_id))),
+      sink_(sink),
+      options_(options),
+      live_maps_(std::move(live_maps)) {
   if (config_.settings.semantic && options_.segmenter) {
     try {
       segmenter_ = makeSegmenter(*options_.segmenter);
@@ -315,10 +324,7 @@ void SlamSessionBackend::startStoreWriter(LiveEdgeMap& live, std::optional<Store
                                           const std::vector<KeyFrameId>& stored_keyframes,
                                           const std::vector<KeyFrameId>& places_missing) {
   if (!options_.store) return;
-  const std::string map =
-      !config_.map_name.empty()
-          ? config_.map_name
-          : defaultMapName(config_.client_name + "-s" + std::to_string(config_.session_id));
+  const std::string& map = store_map_name_;
   try {
     StoreSessionId session = 0;
     if (resumed) {
@@ -392,6 +398,27 @@ std::size_t SlamSessionBackend::loops() const {
   MutexLock view_lock(view_mutex_);
   if (mapping_ && mapping().loopCloser() != nullptr) return mapping().loopCloser()->loops();
   return 0;
+}
+
+std::vector<LoopEvent> SlamSessionBackend::loopEvents() const {
+  MutexLock view_lock(view_mutex_);
+  if (mapping_ && mapping().loopCloser() != nullptr) return mapping().loopCloser()->stats().events;
+  return {};
+}
+
+SlamSessionBackend::MapIdentity SlamSessionBackend::mapIdentity() const {
+  MutexLock view_lock(view_mutex_);
+  MapIdentity identity{.name = store_map_name_};
+  if (offload_) {
+    identity.name = config_.map_name;  // offloaded SLAM keeps its map in memory only
+    identity.map = offload_.get();
+  }
+  if (localization_) {
+    identity.map = localization_.get();
+    identity.localize_only = true;
+  }
+  if (mapping_) identity.map = mapping_.get();
+  return identity;
 }
 
 std::unique_ptr<EdgeSessionBackend> SlamSessionFactory::open(const SessionConfig& config,

@@ -48,6 +48,19 @@ class SlamSessionBackend : public EdgeSessionBackend {
   // it closed.
   MapSample mapSample(std::size_t max_points) const;
   std::size_t loops() const;
+  // The loops closed in the session's map (a shared map's: every client's), merges included.
+  std::vector<LoopEvent> loopEvents() const;
+  // The map the session writes or localises in, for a viewer: its name in the store ("" when the
+  // server keeps none and the client named none) and an identity the sessions of one shared map
+  // have in common (nullptr before the session has a map).
+  struct MapIdentity {
+    std::string name;
+    const void* map = nullptr;
+    bool localize_only = false;
+  };
+  MapIdentity mapIdentity() const;
+  // The top byte of the ids of the keyframes this session's client makes.
+  std::uint8_t clientIdOrigin() const { return config_.id_origin; }
 
  private:
   // The map's latest stored session with keyframes, when the session names a stored map.
@@ -69,6 +82,8 @@ class SlamSessionBackend : public EdgeSessionBackend {
   // GUARDED_BY: the session's own thread, their only writer, reads them without it.
   mutable Mutex view_mutex_;
   SessionConfig config_;
+  // The map's name in the store: the client's --map, else one made for this session.
+  std::string store_map_name_;
   SliceSink& sink_;
   SlamSessionOptions options_;
   std::shared_ptr<Segmenter> segmenter_;  // when the session asked for semantic culling

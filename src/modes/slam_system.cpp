@@ -156,7 +156,9 @@ MapSample TrackingSlam::mapSample(std::size_t max_points) const {
   const std::vector<KeyFrame*> keyframes = map_.keyFrames();
   sample.keyframe_poses.reserve(keyframes.size());
   for (const KeyFrame* kf : keyframes) {
-    if (!kf->isBad()) sample.keyframe_poses.push_back(kf->poseInverse());
+    if (kf->isBad()) continue;
+    sample.keyframe_poses.push_back(kf->poseInverse());
+    sample.keyframe_ids.push_back(kf->id());
   }
   sample.points = map_.pointPositionSample(max_points);
   sample.total_points = map_.pointCount();

@@ -95,7 +95,8 @@ struct LinkTraffic {
 
 // A bounded look at the client's map for display.
 struct MapSample {
-  std::vector<SE3d> keyframe_poses;  // camera-to-world, by keyframe id
+  std::vector<SE3d> keyframe_poses;      // camera-to-world, by keyframe id
+  std::vector<KeyFrameId> keyframe_ids;  // of keyframe_poses, one each
   std::vector<Eigen::Vector3d> points;
   std::size_t total_points = 0;  // in the client's map, of which `points` is a subsample
 };

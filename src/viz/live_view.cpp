@@ -30,6 +30,12 @@ void LiveView::markFinished() {
   status_.finished = true;
 }
 
+void LiveView::setRoute(std::vector<Eigen::Vector3d> checkpoints) {
+  MutexLock lock(frame_mutex_);
+  ++version_;
+  route_ = std::move(checkpoints);
+}
+
 void LiveView::setMapSampler(MapSampler sampler) {
   MutexLock lock(map_mutex_);
   sampler_ = std::move(sampler);
@@ -61,6 +67,7 @@ void LiveView::refreshMapIfDue() {
     }
     std::reverse(kept.begin(), kept.end());
     map_.keyframe_poses = std::move(kept);
+    map_.keyframe_ids.clear();  // not shown
   }
   map_taken_at_ = now;
   ++map_generation_;
@@ -74,6 +81,7 @@ ViewSnapshot LiveView::snapshotLocked() {
     out.status = status_;
     if (camera_) out.camera = ViewPose{camera_->translation(), camera_->rotation()};
     out.trajectory = trajectory_.positions();
+    out.route = route_;
     if (ground_truth_anchor_) {
       out.ground_truth.reserve(ground_truth_.positions().size());
       for (const Eigen::Vector3d& p : ground_truth_.positions()) {

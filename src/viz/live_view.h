@@ -11,6 +11,7 @@
 #include <functional>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "geometry/se3.h"
 #include "modes/slam_system.h"
@@ -42,6 +43,8 @@ class LiveView : public ViewSource {
   void publishFrame(const RunStatus& status, const std::optional<SE3d>& camera,
                     const std::optional<SE3d>& ground_truth);
   void markFinished();
+  // The checkpoints of the route the client follows (in the trajectory's frame), once.
+  void setRoute(std::vector<Eigen::Vector3d> checkpoints);
   void setMapSampler(MapSampler sampler);
   // Drops the sampler (before what it samples goes away); the last sample stays on show.
   void clearMapSampler();
@@ -68,6 +71,7 @@ class LiveView : public ViewSource {
   TrajectoryDecimator ground_truth_ GUARDED_BY(frame_mutex_);
   // Trajectory frame from ground-truth frame.
   std::optional<SE3d> ground_truth_anchor_ GUARDED_BY(frame_mutex_);
+  std::vector<Eigen::Vector3d> route_ GUARDED_BY(frame_mutex_);
 
   Mutex map_mutex_;  // the readers' side: sampler, map sample and the encoded snapshot
   MapSampler sampler_ GUARDED_BY(map_mutex_);

@@ -14,6 +14,29 @@ double millimetres(double metres) {
   return rounded(metres, 1000.0);
 }
 
+nlohmann::json statusJson(const RunStatus& s) {
+  return {{"frame", s.frame},
+          {"frames_total", s.frames_total},
+          {"fps", rounded(s.fps, 10.0)},
+          {"state", s.state},
+          {"tracked_points", s.tracked_points},
+          {"keyframes", s.keyframes},
+          {"map_points", s.map_points},
+          {"client_ms", rounded(s.client_ms, 100.0)},
+          {"e2e_ms", rounded(s.e2e_ms, 100.0)},
+          {"uplink_bytes", s.uplink_bytes},
+          {"downlink_bytes", s.downlink_bytes},
+          {"mode", s.mode},
+          {"sensor", s.sensor},
+          {"link", s.link},
+          {"adaptation_row", s.adaptation_row},
+          {"instruction", s.instruction},
+          {"checkpoint", s.checkpoint},
+          {"finished", s.finished}};
+}
+
+}  // namespace
+
 nlohmann::json flatPositions(const std::vector<Eigen::Vector3d>& positions) {
   nlohmann::json out = nlohmann::json::array();
   out.get_ref<nlohmann::json::array_t&>().reserve(positions.size() * 3);
@@ -37,28 +60,6 @@ std::optional<nlohmann::json> poseJson(const ViewPose& pose) {
        {rounded(q.x(), 1e4), rounded(q.y(), 1e4), rounded(q.z(), 1e4), rounded(q.w(), 1e4)}}};
 }
 
-nlohmann::json statusJson(const RunStatus& s) {
-  return {{"frame", s.frame},
-          {"frames_total", s.frames_total},
-          {"fps", rounded(s.fps, 10.0)},
-          {"state", s.state},
-          {"tracked_points", s.tracked_points},
-          {"keyframes", s.keyframes},
-          {"map_points", s.map_points},
-          {"client_ms", rounded(s.client_ms, 100.0)},
-          {"e2e_ms", rounded(s.e2e_ms, 100.0)},
-          {"uplink_bytes", s.uplink_bytes},
-          {"downlink_bytes", s.downlink_bytes},
-          {"mode", s.mode},
-          {"sensor", s.sensor},
-          {"link", s.link},
-          {"adaptation_row", s.adaptation_row},
-          {"instruction", s.instruction},
-          {"finished", s.finished}};
-}
-
-}  // namespace
-
 nlohmann::json toJson(const ViewSnapshot& snapshot) {
   nlohmann::json keyframes = nlohmann::json::array();
   for (const ViewPose& kf : snapshot.keyframes) {
@@ -74,7 +75,8 @@ nlohmann::json toJson(const ViewSnapshot& snapshot) {
           {"ground_truth", flatPositions(snapshot.ground_truth)},
           {"keyframes", std::move(keyframes)},
           {"points", flatPositions(snapshot.points)},
-          {"points_total", snapshot.points_total}};
+          {"points_total", snapshot.points_total},
+          {"route", flatPositions(snapshot.route)}};
 }
 
 }  // namespace edgeslam::viz

@@ -31,6 +31,7 @@ struct RunStatus {
   int adaptation_row = -1;  // Table I row in use (0-based); -1 without self-adaptation
   bool finished = false;    // the run is over (the viewer lingers on the final map)
   std::string instruction;  // following a route: the latest navigation instruction ("" without)
+  int checkpoint = -1;      // following a route: the checkpoint it leads to (0-based; -1 without)
 };
 
 struct ViewPose {
@@ -46,11 +47,15 @@ struct ViewSnapshot {
   std::vector<Eigen::Vector3d> ground_truth;  // in the trajectory's frame; empty without one
   std::vector<ViewPose> keyframes;
   std::vector<Eigen::Vector3d> points;
-  std::size_t points_total = 0;  // in the map the points were sampled from
+  std::size_t points_total = 0;        // in the map the points were sampled from
+  std::vector<Eigen::Vector3d> route;  // checkpoints of the route followed, in order; or none
 };
 
 // Positions are rounded to the millimetre and flattened ([x0, y0, z0, x1, ...]) to keep the
 // message small; anything not finite is left out (a position) or written as 0 (a figure).
 nlohmann::json toJson(const ViewSnapshot& snapshot);
+// The same encodings for other views: positions flattened, a pose (nullopt when not finite).
+nlohmann::json flatPositions(const std::vector<Eigen::Vector3d>& positions);
+std::optional<nlohmann::json> poseJson(const ViewPose& pose);
 
 }  // namespace edgeslam::viz

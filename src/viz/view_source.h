@@ -1,6 +1,7 @@
 #pragma once
 // What the viewer's HTTP server shows: a run's LiveView (the mobile view) or an edge server's
 // EdgeView. Called from the viewer's threads.
+#include <optional>
 #include <string>
 
 #include "viz/frame_image_slot.h"
@@ -14,6 +15,10 @@ class ViewSource {
   virtual std::string snapshotJson() = 0;
   // The camera image, where the view has one.
   virtual FrameImageSlot* images() { return nullptr; }
+  // A map the view can show on request (the edge view's stored maps) as JSON; nullopt: none.
+  virtual std::optional<std::string> storedMapJson(const std::string& /*name*/) {
+    return std::nullopt;
+  }
 };
 
 }  // namespace edgeslam::viz

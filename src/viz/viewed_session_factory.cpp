@@ -35,8 +35,11 @@ class ViewedSession : public EdgeSessionBackend {
 }  // namespace
 
 void SessionDirectory::opened(Entry entry) {
-  addEvent(fmt::format("session {} '{}' ({}) joined", entry.session_id, entry.client_name,
-                       entry.sensor));
+  addEvent(entry.map_name.empty()
+               ? fmt::format("session {} '{}' ({}) joined", entry.session_id, entry.client_name,
+                             entry.sensor)
+               : fmt::format("session {} '{}' ({}) joined, map '{}'", entry.session_id,
+                             entry.client_name, entry.sensor, entry.map_name));
   MutexLock lock(mutex_);
   ++opened_;
   sessions_.push_back(std::move(entry));
@@ -86,6 +89,7 @@ std::unique_ptr<EdgeSessionBackend> ViewedSessionFactory::open(const SessionConf
   directory_->opened({.session_id = config.session_id,
                       .client_name = config.client_name,
                       .sensor = toString(config.sensor),
+                      .map_name = config.map_name,
                       .backend = std::dynamic_pointer_cast<SlamSessionBackend>(backend)});
   return std::make_unique<ViewedSession>(std::move(backend), config.session_id, directory_);
 }

@@ -27,6 +27,7 @@ class SessionDirectory {
     std::uint64_t session_id = 0;
     std::string client_name;
     std::string sensor;
+    std::string map_name;  // as the client named it ("" for a map of its own)
     // Sampling holds the backend for that long; nullptr when the factory's backends are not
     // SlamSessionBackends (nothing to sample).
     std::weak_ptr<SlamSessionBackend> backend;

@@ -104,6 +104,25 @@ void ViewerServer::addRoutes() {
     res.set_header("Cache-Control", "no-cache");
     res.set_content(view_.snapshotJson(), "application/json");
   });
+  server_->Get("/api/map", [this](const httplib::Request& req, httplib::Response& res) {
+    runAtNice(options_.thread_nice);
+    res.set_header("Cache-Control", "no-cache");
+    const std::string name = req.get_param_value("name");
+    std::optional<std::string> json;
+    try {
+      if (!name.empty()) json = view_.storedMapJson(name);
+    } catch (const std::exception& e) {
+      res.status = 500;
+      res.set_content(std::string("the map cannot be read: ") + e.what() + "\n", "text/plain");
+      return;
+    }
+    if (!json) {
+      res.status = 404;
+      res.set_content("no such map\n", "text/plain");
+      return;
+    }
+    res.set_content(std::move(*json), "application/json");
+  });
   server_->Get("/api/frame.jpg", [this](const httplib::Request&, httplib::Response& res) {
     runAtNice(options_.thread_nice);
     res.set_header("Cache-Control", "no-store");

@@ -1,8 +1,9 @@
 // The web viewer in a real browser: Debian's chromium, headless, driven by puppeteer-core against
 // the real binary. Mobile view (`run --viewer`): the page connects, map points and camera images
 // arrive and keep updating, and it reconnects when the run is restarted on the same port. Edge view
-// (`server --viewer` with a `client` run): the session, its map and its figures arrive and keep
-// updating, and the page reconnects after a server restart.
+// (`server --viewer` with two `client` runs into one map): the map with both clients' trajectories
+// and their figures arrive and keep updating; after a server restart the page reconnects and shows
+// the map from the store.
 //
 //   node viewer_test.mjs --edgeslam BIN --dataset DIR --modules web/node_modules
 //                        [--chromium PATH] [--screenshots DIR]
@@ -121,7 +122,9 @@ async function mobileView(browser) {
   await stop(first.child);
   await waitFor(page, (p) => !p.connected, 'the page to notice the run stopped', 15000);
   const before = await progress(page);
-  const second = await start(runArgs(port, 60), /viewer: http/, 'second run');
+  // Long enough (10 s) that the page's retry (a few seconds) finds it still running: a finished
+  // run's snapshot no longer changes, so one message would be all the page gets.
+  const second = await start(runArgs(port, 300), /viewer: http/, 'second run');
   await waitFor(page, (p) => p.connected && p.messages > before.messages + 1 && p.reconnects >= 1,
     'the page to reconnect to the restarted run', 30000);
   console.log('mobile: reconnected after a restart');
@@ -135,34 +138,44 @@ async function edgeView(browser) {
     '--semantic', 'off', '--vocab', 'none', '--status-every', '0', '--maps', path.join(outDir, 'maps')];
   const server = await start(serverArgs(0, '127.0.0.1:0'), /viewer: (http:\/\/[\d.]+:(\d+)\/)[\s\S]*listening on ([\d.]+:\d+)/, 'server');
   const [, url, viewerPort, address] = server.match;
-  // The client plays on until the test stops it: on a loaded host the page may take most of a
-  // minute to see the first session, and a client that had ended by then left nothing to update.
-  const clientArgs = ['client', '--server', address, '--dataset', args.dataset, '--realtime', '--frames', '0-299',
-    '--repeat', '100', '--vocab', 'none', '--out', path.join(outDir, 'client')];
-  const client = await start(clientArgs, /frame/, 'client');
+  // Two clients into one map at once. They play on until the test stops them: on a loaded host
+  // the page may take most of a minute to see the first session, and clients that had ended by
+  // then left nothing to update.
+  const clientArgs = (name, frames) => ['client', '--server', address, '--dataset', args.dataset, '--realtime',
+    '--frames', frames, '--repeat', '100', '--vocab', 'none', '--map', 'shared',
+    '--out', path.join(outDir, name)];
+  const first = await start(clientArgs('first', '0-299'), /frame/, 'first client');
+  const second = await start(clientArgs('second', '100-399'), /frame/, 'second client');
   const page = await browser.newPage();
   await page.setViewport({ width: 1280, height: 800, deviceScaleFactor: 1 });
   const errors = [];
   page.on('pageerror', (e) => errors.push(e.message));
   await page.goto(url);
-  const a = await waitFor(page, (p) => p.view === 'edge' && p.sessions >= 1 && p.points > 0,
-    'a session with map points');
+  const a = await waitFor(page, (p) => p.view === 'edge' && p.sessions >= 2 && p.points > 0 &&
+    p.map_shown === 'shared' && p.map_live && p.map_clients >= 2, 'one live map with both clients\' keyframes');
   const b = await waitFor(page, (p) => p.last_version > a.last_version + 2, 'the edge map to keep updating', 20000);
-  console.log(`edge: ${b.sessions} session(s), ${b.points} points, ${b.messages} snapshots`);
+  console.log(`edge: ${b.sessions} session(s) in map '${b.map_shown}' (${b.map_clients} trajectories), ` +
+    `${b.points} points, ${b.messages} snapshots`);
   const events = await page.$eval('#events', (el) => el.textContent);
-  if (!/joined/.test(events)) fail(`no join in the event list: ${events}`);
+  if (!/joined, map 'shared'/.test(events)) fail(`no join in the event list: ${events}`);
   if (args.screenshots) {
     await sleep(4000);
     await page.screenshot({ path: path.join(args.screenshots, 'viewer-edge.png') });
   }
-  await stop(client.child);
+  await stop(first.child);
+  await stop(second.child);
   await stop(server.child);
   await waitFor(page, (p) => !p.connected, 'the page to notice the server stopped', 15000);
   const before = await progress(page);
+  // Started again on the same store: the map is now one the store holds, shown when picked (the
+  // first map when none is live).
   const restarted = await start(serverArgs(viewerPort, '127.0.0.1:0'), /listening on/, 'restarted server');
   await waitFor(page, (p) => p.connected && p.messages > before.messages && p.reconnects >= 1,
     'the page to reconnect to the restarted server', 30000);
   console.log('edge: reconnected after a server restart');
+  const c = await waitFor(page, (p) => p.map_shown === 'shared' && p.map_live === false && p.stored_points > 0,
+    'the stored map to be listed and shown', 30000);
+  console.log(`edge: stored map '${c.map_shown}' shown, ${c.stored_points} points`);
   await stop(restarted.child);
   if (errors.length) fail(`page errors: ${errors.join('; ')}`);
   await page.close();

@@ -4,6 +4,8 @@
 // own yet: it maps in a part of its own, and a loop between the two parts merges them. The stored
 // map then holds both clients' keyframes in one frame: its keyframe ATE, with one SE(3) alignment
 // for all of them, is compared with a single client's over the whole sequence into its own map.
+// The server's edge view is watched meanwhile: one map with both clients' trajectories, the merge
+// drawn and told as an event.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -13,8 +15,10 @@
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <regex>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "io/trajectory.h"
@@ -23,6 +27,9 @@
 #include "support/fresh_temp_dir.h"
 #include "support/shared_data.h"
 #include "support/small_vocabulary.h"
+// clang-format off: after every header that includes Eigen, whose headers httplib's macros break.
+#include <httplib.h>
+// clang-format on
 
 namespace edgeslam {
 namespace {
@@ -81,6 +88,33 @@ StoredMapFigures storedMap(const std::filesystem::path& store, const std::string
   return figures;
 }
 
+// What the edge view showed of map `map` while it was live.
+struct EdgeViewSeen {
+  std::size_t snapshots = 0;
+  std::size_t most_trajectories = 0;  // clients' keyframes in the map at once
+  std::size_t sessions_in_map = 0;
+  bool merge_drawn = false;  // a loop of the map marked as a merge
+  std::string events;        // the latest event list, one per line
+};
+
+void look(httplib::Client& viewer, const std::string& map, EdgeViewSeen& seen) {
+  const auto response = viewer.Get("/api/state");
+  if (!response || response->status != 200) return;
+  const auto snapshot = nlohmann::json::parse(response->body, nullptr, false);
+  if (!snapshot.is_object()) return;
+  ++seen.snapshots;
+  for (const auto& m : snapshot.value("maps", nlohmann::json::array())) {
+    if (m.value("name", "") != map || !m.value("live", false)) continue;
+    seen.most_trajectories = std::max(seen.most_trajectories, m["trajectories"].size());
+    seen.sessions_in_map = std::max(seen.sessions_in_map, m["sessions"].size());
+    for (const auto& loop : m["loops"]) seen.merge_drawn |= loop.value("merge", false);
+  }
+  seen.events.clear();
+  for (const auto& e : snapshot.value("events", nlohmann::json::array())) {
+    seen.events += e.value("text", "") + "\n";
+  }
+}
+
 TEST(SharedMap, TwoClientsMappingOneMapAtOnceEndInOneFrame) {
   EDGESLAM_REQUIRE_SHARED(kSequence);
   const auto work = test::freshTempDir("shared_map");
@@ -94,9 +128,16 @@ TEST(SharedMap, TwoClientsMappingOneMapAtOnceEndInOneFrame) {
   const std::string address = "127.0.0.1:" + std::to_string(port);
   test::ChildProcess server(test::edgeslamBinary(),
                             words("server --listen " + address + " --status-every 0" + vocab +
-                                  " --semantic off --maps " + store.string()),
+                                  " --semantic off --viewer 0 --maps " + store.string()),
                             logs / "server.log");
   ASSERT_TRUE(server.waitForLog("listening", kServerReady)) << server.log();
+  std::smatch viewer_url;
+  const std::string startup_log = server.log();
+  ASSERT_TRUE(
+      std::regex_search(startup_log, viewer_url, std::regex(R"(viewer: http://[\d.]+:(\d+)/)")))
+      << startup_log;
+  httplib::Client viewer("127.0.0.1", std::stoi(viewer_url[1]));
+  viewer.set_read_timeout(std::chrono::seconds(10));
 
   const auto client = [&](const std::string& name, const std::string& frames,
                           const std::string& map) {
@@ -109,6 +150,12 @@ TEST(SharedMap, TwoClientsMappingOneMapAtOnceEndInOneFrame) {
   // The two halves at once, into one map.
   auto first = client("first", "0-549", "kitchen");
   auto second = client("second", "450-999", "kitchen");
+  EdgeViewSeen seen;
+  const auto deadline = std::chrono::steady_clock::now() + kClientRun;
+  while ((first->running() || second->running()) && std::chrono::steady_clock::now() < deadline) {
+    look(viewer, "kitchen", seen);
+    std::this_thread::sleep_for(std::chrono::seconds(1));
+  }
   EXPECT_EQ(first->wait(kClientRun), 0) << first->log();
   EXPECT_EQ(second->wait(kClientRun), 0) << second->log();
   // One client over the whole sequence into a map of its own: the accuracy to match.
@@ -121,6 +168,14 @@ TEST(SharedMap, TwoClientsMappingOneMapAtOnceEndInOneFrame) {
   // The second client joined the first's map, and a loop merged their parts.
   EXPECT_NE(server_log.find("joins map 'kitchen'"), std::string::npos) << server_log;
   EXPECT_NE(server_log.find("maps merged"), std::string::npos) << server_log;
+
+  // The edge view showed one map with both clients in it, and the merge.
+  std::printf("edge view: %zu snapshots, up to %zu trajectories in the map, merge drawn: %d\n",
+              seen.snapshots, seen.most_trajectories, seen.merge_drawn ? 1 : 0);
+  EXPECT_GE(seen.most_trajectories, 2u) << seen.snapshots << " snapshots";
+  EXPECT_EQ(seen.sessions_in_map, 2u);
+  EXPECT_TRUE(seen.merge_drawn);
+  EXPECT_NE(seen.events.find("maps merged in 'kitchen'"), std::string::npos) << seen.events;
 
   // Each client's session is recorded with the map.
   const auto info = test::runEdgeslam("map info kitchen --json --maps " + store.string());

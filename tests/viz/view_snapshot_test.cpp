@@ -54,6 +54,19 @@ TEST(VizSnapshotJson, HasEveryField) {
   EXPECT_DOUBLE_EQ(j["trajectory"][3].get<double>(), 0.123);
   EXPECT_EQ(j["points"].size(), 9u);
   EXPECT_EQ(j["ground_truth"].size(), 0u);
+  EXPECT_EQ(j["route"].size(), 0u);
+  EXPECT_EQ(j["status"]["checkpoint"], -1);
+}
+
+TEST(VizSnapshotJson, CarriesTheRouteFollowedAndItsNextCheckpoint) {
+  ViewSnapshot s = exampleSnapshot();
+  s.route = {{0, 0, 0}, {1, 0, 0}, {1, 0, 2}};
+  s.status.instruction = "go straight to checkpoint 2 of 3 (0.80 m)";
+  s.status.checkpoint = 1;
+  const nlohmann::json j = toJson(s);
+  EXPECT_EQ(j["route"], nlohmann::json({0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 0.0, 2.0}));
+  EXPECT_EQ(j["status"]["checkpoint"], 1);
+  EXPECT_EQ(j["status"]["instruction"], s.status.instruction);
 }
 
 TEST(VizSnapshotJson, NoCameraIsNull) {
