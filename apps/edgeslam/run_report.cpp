@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <numeric>
 
 #include "intrinsics_report.h"
 #include "map_store_option.h"
@@ -23,6 +24,43 @@ namespace {
 // Maps started after a loss that no merge joined back (each merge joins one; never negative).
 std::size_t unmergedMaps(std::size_t started, std::uint64_t merges) {
   return started > merges ? started - static_cast<std::size_t>(merges) : 0;
+}
+
+// Frames by the age of their mask: median / p90 / max and coarse buckets (docs/semantic.md).
+nlohmann::json maskAgeJson(const std::array<std::uint64_t, 65>& by_age) {
+  const std::uint64_t total = std::accumulate(by_age.begin(), by_age.end(), std::uint64_t{0});
+  const auto quantile = [&](double q) -> nlohmann::json {
+    if (total == 0) return nullptr;
+    std::uint64_t seen = 0;
+    for (std::size_t age = 0; age < by_age.size(); ++age) {
+      seen += by_age[age];
+      if (static_cast<double>(seen) >= q * static_cast<double>(total)) return age;
+    }
+    return by_age.size() - 1;
+  };
+  std::size_t last = 0;
+  for (std::size_t age = 0; age < by_age.size(); ++age) {
+    if (by_age[age] > 0) last = age;
+  }
+  nlohmann::json buckets = nlohmann::json::object();
+  const auto bucket = [&](const char* name, std::size_t from, std::size_t to) {
+    buckets[name] =
+        std::accumulate(by_age.begin() + static_cast<std::ptrdiff_t>(from),
+                        by_age.begin() + static_cast<std::ptrdiff_t>(to + 1), std::uint64_t{0});
+  };
+  bucket("0", 0, 0);
+  bucket("1", 1, 1);
+  bucket("2", 2, 2);
+  bucket("3-4", 3, 4);
+  bucket("5-8", 5, 8);
+  bucket("9-16", 9, 16);
+  bucket("17-32", 17, 32);
+  bucket(">32", 33, by_age.size() - 1);
+  return {{"frames", total},
+          {"median", quantile(0.5)},
+          {"p90", quantile(0.9)},
+          {"max", total == 0 ? nlohmann::json(nullptr) : nlohmann::json(last)},
+          {"buckets", std::move(buckets)}};
 }
 
 }  // namespace
@@ -196,6 +234,12 @@ void RunReport::addModeMetrics() {
                                {"frames_with_mask", s.frames_with_mask},
                                {"features_culled", s.features_culled},
                                {"client_ms", toJson(s.client_ms)}};
+    // Keyframes are segmented after they are tracked, so every tracked frame's mask is one
+    // transferred from an earlier keyframe (or there is none yet).
+    semantic["mask_source"] = {{"segmented_keyframes", s.keyframes_segmented},
+                               {"transferred", s.frames_with_mask},
+                               {"none", s.frames_without_mask}};
+    semantic["mask_age_frames"] = maskAgeJson(s.mask_age);
     if (companions_.semantic_eval) semantic.update(companions_.semantic_eval->json());
     metrics["semantic"] = semantic;
   }

@@ -30,8 +30,10 @@ void SemanticEvaluation::addFrame(std::size_t index, const TrackResult& result,
                                   const SemanticFrame* frame) {
   if (frame == nullptr || frame->all == nullptr || index >= masks_.size()) return;
   const cv::Mat1b truth = masks_.load(index);
-  if (!frame->mask.empty() && !result.new_keyframe) {
-    if (const auto iou = maskIoU(frame->mask, truth)) {
+  if (!frame->mask.empty()) {
+    const auto iou = maskIoU(frame->mask, truth);
+    if (iou && result.new_keyframe) iou_keyframes_.add(*iou);
+    if (iou && !result.new_keyframe) {
       iou_.add(*iou);
       if (spdlog::should_log(spdlog::level::debug)) {
         spdlog::debug(
@@ -44,6 +46,7 @@ void SemanticEvaluation::addFrame(std::size_t index, const TrackResult& result,
   }
   features_on_people_ += countFeaturesOnMask(positions(*frame->all), truth).on_mask;
   features_on_people_kept_ += countFeaturesOnMask(positions(*frame->kept), truth).on_mask;
+  features_culled_ += frame->all->size() - frame->kept->size();
 }
 
 nlohmann::json SemanticEvaluation::json() const {
@@ -51,6 +54,19 @@ nlohmann::json SemanticEvaluation::json() const {
   out["mask_iou_median"] =
       iou_.count() > 0 ? nlohmann::json(iou_.summary().median) : nlohmann::json(nullptr);
   out["mask_iou_frames"] = iou_.count();
+  out["mask_iou_keyframes_median"] = iou_keyframes_.count() > 0
+                                         ? nlohmann::json(iou_keyframes_.summary().median)
+                                         : nlohmann::json(nullptr);
+  out["mask_iou_keyframes_frames"] = iou_keyframes_.count();
+  const std::size_t culled_on_people = features_on_people_ - features_on_people_kept_;
+  out["culled_precision"] = features_culled_ > 0
+                                ? nlohmann::json(static_cast<double>(culled_on_people) /
+                                                 static_cast<double>(features_culled_))
+                                : nlohmann::json(nullptr);
+  out["culled_recall"] = features_on_people_ > 0
+                             ? nlohmann::json(static_cast<double>(culled_on_people) /
+                                              static_cast<double>(features_on_people_))
+                             : nlohmann::json(nullptr);
   out["dynamic_features"] = features_on_people_;
   out["dynamic_features_kept_ratio"] =
       features_on_people_ > 0 ? nlohmann::json(static_cast<double>(features_on_people_kept_) /

@@ -22,8 +22,11 @@ class SemanticEvaluation {
   // After frame `index` was processed; `frame` may be nullptr (offload mode: nothing to score).
   void addFrame(std::size_t index, const TrackResult& result, const SemanticFrame* frame);
 
-  // mask_iou_median (null without any scored frame), mask_iou_frames,
-  // dynamic_features_kept_ratio (null without any feature on people), dynamic_features.
+  // mask_iou_median (non-keyframes; null without any scored frame), mask_iou_frames,
+  // mask_iou_keyframes_median / _frames (keyframes, with the mask they were tracked with),
+  // dynamic_features_kept_ratio (null without any feature on people), dynamic_features,
+  // culled_precision (culled features that were on people) and culled_recall (features on people
+  // that were culled), null where nothing was culled / on people.
   nlohmann::json json() const;
   std::string summaryLine() const;
 
@@ -32,8 +35,10 @@ class SemanticEvaluation {
 
   GroundTruthMasks masks_;
   SampleStats iou_;
+  SampleStats iou_keyframes_;
   std::size_t features_on_people_ = 0;
   std::size_t features_on_people_kept_ = 0;
+  std::size_t features_culled_ = 0;
 };
 
 }  // namespace edgeslam::cli

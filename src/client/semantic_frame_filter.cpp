@@ -100,6 +100,11 @@ SemanticFrame SemanticFrameFilter::filter(std::size_t frame_index,
   history_.emplace_back(frame_index, std::move(all));
   while (history_.size() > options_.history_frames) history_.pop_front();
   counters_.frames_with_mask += !out.mask.empty();
+  counters_.frames_without_mask += out.mask.empty();
+  if (out.mask_source_frame) {
+    const std::size_t age = frame_index - std::min(frame_index, *out.mask_source_frame);
+    ++counters_.mask_age[std::min<std::size_t>(age, counters_.mask_age.size() - 1)];
+  }
   counters_.features_culled += static_cast<std::size_t>(out.culled);
   return out;
 }

@@ -7,7 +7,9 @@
 // A mask usually arrives several frames after its keyframe. The thread that delivers it carries it
 // forward over the frames seen since (a few steps through the recent frames' features, each a
 // short motion), so the tracking thread only has to take it the last frame or two.
+#include <array>
 #include <cstddef>
+#include <cstdint>
 #include <deque>
 #include <memory>
 #include <mutex>
@@ -45,7 +47,10 @@ struct SemanticFilterCounters {
   std::size_t masks_applied = 0;
   std::size_t masks_too_old = 0;  // their keyframe had left the history
   std::size_t frames_with_mask = 0;
+  std::size_t frames_without_mask = 0;  // before the first mask came back
   std::size_t features_culled = 0;
+  // How many frames after its keyframe the mask each frame got is: [age] up to 63, [64] beyond.
+  std::array<std::uint64_t, 65> mask_age{};
 };
 
 class SemanticFrameFilter {

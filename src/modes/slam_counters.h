@@ -1,6 +1,7 @@
 #pragma once
 // What a run mode counts, grouped by what it measures. Each group is zero where the mode has none
 // of it (local mode exchanges nothing; offload tracks nothing on the client).
+#include <array>
 #include <cstdint>
 
 #include "modes/paced_keyframe_sink.h"
@@ -33,8 +34,11 @@ struct SemanticCounters {
   std::uint64_t movable_points_erased = 0;  // local mode (the edge erases its own)
   PercentileSummary segmentation_ms;        // per keyframe, where it ran
   PercentileSummary client_ms;              // mask transfer and culling per frame
-  std::uint64_t frames_with_mask = 0;
+  std::uint64_t frames_with_mask = 0;       // tracked with a mask transferred from a keyframe's
+  std::uint64_t frames_without_mask = 0;    // tracked before any mask was back
   std::uint64_t features_culled = 0;
+  // Frames by the age of their mask (frames since its keyframe): [age] up to 63, [64] beyond.
+  std::array<std::uint64_t, 65> mask_age{};
 };
 
 // Where the client's time per frame goes (modes that track on the client).

@@ -122,7 +122,9 @@ void TrackingSlam::addClientCounters(SlamCounters& counters) const {
   const SemanticFilterCounters c = semantic_filter_->counters();
   counters.semantic.client_ms = semantic_ms_.summary();
   counters.semantic.frames_with_mask = c.frames_with_mask;
+  counters.semantic.frames_without_mask = c.frames_without_mask;
   counters.semantic.features_culled = c.features_culled;
+  counters.semantic.mask_age = c.mask_age;
 }
 
 Trajectory TrackingSlam::trajectoryAtFrameTime() const {

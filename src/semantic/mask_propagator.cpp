@@ -117,7 +117,11 @@ MaskTransferResult MaskPropagator::propagate(const FrameFeatures& current,
                options_.search_radius_px +
                    options_.search_radius_per_frame_px *
                        static_cast<float>(frames_since_last > 0 ? frames_since_last - 1 : 0));
-  last_matches_ = matchForTransfer(*reference_, labels_.labels_near, current, predict, radius,
+  const SearchRadius radius_of = [&](std::uint8_t label) {
+    if (label == 0 || has_own_motion_[label]) return radius;
+    return std::max(radius, options_.unknown_motion_search_radius_px);
+  };
+  last_matches_ = matchForTransfer(*reference_, labels_.labels_near, current, predict, radius_of,
                                    options_.matching);
   // Instances whose own motion is known keep it when their matches fail them.
   PredictedWarps own_prediction;

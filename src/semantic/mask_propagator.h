@@ -21,6 +21,11 @@ struct MaskPropagatorOptions {
   // first carried to a frame some way past its keyframe), up to max_search_radius_px.
   float search_radius_per_frame_px = 8.f;
   float max_search_radius_px = 96.f;
+  // An instance whose own motion is not known yet (the keyframe's first step, or after its
+  // matches failed) is searched for at least this far: a person close to the camera crosses it
+  // at 30 px a frame, beyond the radius above, and was then left behind where the keyframe saw
+  // them (moved with the background).
+  float unknown_motion_search_radius_px = 72.f;
   // How much an instance's apparent size may change per frame (someone walking at 1.4 m/s, 1.5 m
   // from the camera: ~3 %). Bounds the constant-velocity prediction, which would otherwise
   // compound a growth rate over every frame without matches (a mask grew to the whole image in

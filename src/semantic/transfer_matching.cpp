@@ -1,5 +1,6 @@
 #include "semantic/transfer_matching.h"
 
+#include <array>
 #include <climits>
 
 #include "features/descriptor_distance.h"
@@ -23,6 +24,18 @@ std::uint8_t labelAt(const cv::Mat1b& labels, const cv::Point2f& p) {
 TransferMatches matchForTransfer(const FrameFeatures& reference, const cv::Mat1b& labels_near,
                                  const FrameFeatures& current, const MotionPrediction& predict,
                                  float search_radius_px, const TransferMatchOptions& options) {
+  return matchForTransfer(
+      reference, labels_near, current, predict,
+      [search_radius_px](std::uint8_t) { return search_radius_px; }, options);
+}
+
+TransferMatches matchForTransfer(const FrameFeatures& reference, const cv::Mat1b& labels_near,
+                                 const FrameFeatures& current, const MotionPrediction& predict,
+                                 const SearchRadius& radius, const TransferMatchOptions& options) {
+  std::array<float, 256> radius_of{};
+  for (std::size_t label = 0; label < radius_of.size(); ++label) {
+    radius_of[label] = radius(static_cast<std::uint8_t>(label));
+  }
   std::vector<Candidate> best_for_current(current.size());
   std::vector<int> in_area;
   std::vector<std::uint8_t> label_of(reference.size(), 0);
@@ -35,7 +48,7 @@ TransferMatches matchForTransfer(const FrameFeatures& reference, const cv::Mat1b
     const cv::Point2f predicted = predict(label, kp.pt);
     const int min_level = std::max(0, kp.octave - options.level_window);
     const int max_level = kp.octave + options.level_window;
-    current.grid.featuresInArea(predicted.x, predicted.y, search_radius_px, min_level, max_level,
+    current.grid.featuresInArea(predicted.x, predicted.y, radius_of[label], min_level, max_level,
                                 in_area);
     const std::uint8_t* descriptor = reference.descriptors.ptr<std::uint8_t>(static_cast<int>(r));
     int best = INT_MAX, second = INT_MAX, best_index = -1;

@@ -29,8 +29,16 @@ struct TransferMatches {
 // Predicted current position of a keyframe pixel on instance `label` (0 = background).
 using MotionPrediction = std::function<cv::Point2f(std::uint8_t label, cv::Point2f reference)>;
 
+// How far around its predicted position a keyframe feature on `label` is searched for (pixels).
+using SearchRadius = std::function<float(std::uint8_t label)>;
+
 // `labels_near` is the keyframe's label image grown by the margin within which a feature counts
 // as on an instance. Each current feature is used at most once (the closer descriptor wins).
+TransferMatches matchForTransfer(const FrameFeatures& reference, const cv::Mat1b& labels_near,
+                                 const FrameFeatures& current, const MotionPrediction& predict,
+                                 const SearchRadius& radius,
+                                 const TransferMatchOptions& options = {});
+// The same radius for every label.
 TransferMatches matchForTransfer(const FrameFeatures& reference, const cv::Mat1b& labels_near,
                                  const FrameFeatures& current, const MotionPrediction& predict,
                                  float search_radius_px, const TransferMatchOptions& options = {});
