@@ -53,10 +53,11 @@ def wait_for_port(port, proc, timeout_s=30.0):
     raise RuntimeError(f"nothing listens on port {port}")
 
 
-def run_once(binary, dataset, sensor, mode, semantic, max_frames, extra):
+def run_once(binary, dataset, sensor, mode, semantic, max_frames, extra, pacing="--realtime"):
     with tempfile.TemporaryDirectory() as out:
-        # At the camera's rate: how many frames late a mask arrives is what the transfer must bridge.
-        common = ["--dataset", dataset, "--sensor", sensor, "--semantic", semantic, "--realtime",
+        # At the camera's rate by default: how many frames late a mask arrives is what the
+        # transfer must bridge.
+        common = ["--dataset", dataset, "--sensor", sensor, "--semantic", semantic, pacing,
                   "--out", out]
         if max_frames:
             common += ["--max-frames", str(max_frames)]

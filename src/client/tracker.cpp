@@ -120,6 +120,7 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
     if (initialize(frame)) {
       if (!diagnostics_.initialized_at_frame) diagnostics_.initialized_at_frame = frame_index;
       ++diagnostics_.initializations;
+      current_map_initialised_at_ = frame.timestamp;
       state_ = TrackingState::kOk;
       result.new_keyframe = true;
       if (reference_keyframe_ != nullptr) result.keyframe = reference_keyframe_->id();
@@ -225,7 +226,10 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
 
   if (new_keyframe != nullptr && sink_ != nullptr) sink_->insertKeyFrame(new_keyframe);
 
-  // A monocular map that is lost within its first few keyframes is not worth keeping.
+  // A monocular map that is lost within its first few keyframes, or its first second, is not
+  // worth keeping. (A map begun on someone walking by makes a keyframe a frame while it lasts:
+  // 6 keyframes in 9 frames on a generated sequence, lost when that person's points were culled,
+  // and never relocalised.) Camera time, so that the rule is the same at any frame rate.
   if (state_ == TrackingState::kLost && options_.sensor == Sensor::kMonocular && frames_lost_ > 0 &&
       !options_.localization_only) {
     std::size_t keyframes = 0;
@@ -233,15 +237,18 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
       MutexLock lock(map_.updateMutex());
       keyframes = currentMapKeyFrames();
     }
-    if (keyframes <= 5 && !maps_started_at_.empty()) {
+    const bool young =
+        keyframes <= 5 || frame.timestamp - current_map_initialised_at_ < kYoungMapSeconds;
+    if (young && !maps_started_at_.empty()) {
       // A map started after an older one was lost: the older stays; another start is tried.
       startNewMap(frame);
       record(frame, false);
       result.state = TrackingState::kLost;
       return result;
     }
-    if (keyframes <= 5) {
-      spdlog::warn("map lost with only {} keyframes: starting a new one", keyframes);
+    if (young) {
+      spdlog::warn("map lost with only {} keyframes, {:.2f} s after it began: starting a new one",
+                   keyframes, frame.timestamp - current_map_initialised_at_);
       if (sink_ != nullptr) sink_->onMapReset();
       resetMap();
       record(frame, false);

@@ -205,6 +205,9 @@ class Tracker {
   // trajectory goes on from there until a merge puts it in the old map's frame.
   std::optional<SE3d> new_map_start_pose_;
   KeyFrameId current_map_first_keyframe_ = 0;  // ids below belong to older maps
+  double current_map_initialised_at_ = 0.0;    // timestamp, s
+  // A monocular map lost within this much camera time of its start is started again.
+  static constexpr double kYoungMapSeconds = 1.0;
   KeyFrameTriangulationStats triangulation_;
   TrackingDiagnostics diagnostics_;
 };

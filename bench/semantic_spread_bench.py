@@ -1,0 +1,208 @@
+#!/usr/bin/env python3
+"""Semantic culling over a spread of generated dynamic sequences (issue 21): N sequences made by
+`edgeslam synth-dynamic` from 7-Scenes redkitchen, each with its own seed, frame range, number of
+people (1-3) and their size (target coverage 10-38 %; the walks' speeds come from the seed),
+alternately RGB-D and monocular. Each is run three times in local mode: on the source frames
+(static), with semantic culling off, and on. Reported per sequence and as a distribution (median,
+worst): transferred-mask IoU on non-keyframes and on keyframes, culled-feature precision and
+recall, ATE of the run against the static run (semantic on and off), mask age.
+
+Two sets with disjoint seeds: `tuning` (seeds 1000+i: for trying changes) and `report` (seeds
+2000+i: for the figures in docs; not to tune on). The tables go into docs/dynamic_benchmark.md
+between <!-- semantic-spread-SET-PACING --> markers.
+
+  bench/semantic_spread_bench.py [--set report] [--count 20] [--length 240]
+                                 [--pacing realtime|fast] [--build-dir build] [--no-docs]
+"""
+import argparse
+import json
+import os
+import random
+import re
+import statistics
+import subprocess
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from semantic_bench import ROOT, ate_cm, run_once  # noqa: E402
+
+SET_SEEDS = {"tuning": 1000, "report": 2000}
+SOURCE = "datasets/7scenes-redkitchen-1000"
+SOURCE_FRAMES = 1000
+
+
+def plan(set_name, count, length):
+    """The set's sequences: the same every time (drawn from the set's seeds)."""
+    sequences = []
+    for i in range(count):
+        seed = SET_SEEDS[set_name] + i
+        rng = random.Random(seed)
+        start = rng.randrange(0, SOURCE_FRAMES - length + 1)
+        sequences.append({
+            "name": f"{set_name}-{i:02d}", "seed": seed,
+            "frames": f"{start}-{start + length - 1}",
+            "people": rng.choice([1, 2, 3]),
+            "coverage": rng.choice([10, 16, 22, 30, 38]),
+            "sensor": "rgbd" if i % 2 == 0 else "mono",
+        })
+    return sequences
+
+
+def generate(binary, shared, work, seq):
+    out = os.path.join(work, f"{seq['name']}-seed{seq['seed']}")
+    if not os.path.exists(os.path.join(out, "masks.txt")):
+        subprocess.run([binary, "synth-dynamic", "--dataset", os.path.join(shared, SOURCE),
+                        "--out", out, "--frames", seq["frames"], "--seed", str(seq["seed"]),
+                        "--num-people", str(seq["people"]), "--coverage", str(seq["coverage"]),
+                        "--overwrite"], check=True, stdout=subprocess.DEVNULL)
+    with open(os.path.join(out, "synth.json")) as f:
+        synth = json.load(f)
+    speeds = [
+        ((w["to_m"][0] - w["from_m"][0]) ** 2 + (w["to_m"][1] - w["from_m"][1]) ** 2) ** 0.5
+        / w["duration_s"]
+        for person in synth["people"] for w in person["walks"] if w["duration_s"] > 0]
+    seq["walk_speed"] = statistics.median(speeds) if speeds else None
+    seq["coverage_median"] = synth["coverage"]["median"]
+    seq["frames_with_people"] = synth["coverage"]["frames_with_people"]
+    return out
+
+
+def semantic(m, key):
+    value = m.get("semantic", {}).get(key)
+    return value
+
+
+def distribution(values, worst):
+    values = [v for v in values if v is not None]
+    if not values:
+        return None, None
+    return statistics.median(values), worst(values)
+
+
+def fmt(value, spec):
+    return "-" if value is None else format(value, spec)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--build-dir", default=os.path.join(ROOT, "build"))
+    parser.add_argument("--shared", default=os.environ.get("EDGESLAM_SHARED",
+                                                           os.path.join(ROOT, "..", "shared")))
+    parser.add_argument("--work", default="/tmp/edgeslam-semantic-spread",
+                        help="where the generated sequences are kept (reused when present)")
+    parser.add_argument("--set", choices=sorted(SET_SEEDS), default="report")
+    parser.add_argument("--count", type=int, default=20)
+    parser.add_argument("--length", type=int, default=240, help="frames per sequence")
+    parser.add_argument("--pacing", choices=["realtime", "fast"], default="realtime")
+    parser.add_argument("--only", help="comma-separated sequence numbers to run (for trying)")
+    parser.add_argument("--no-docs", action="store_true")
+    args = parser.parse_args()
+
+    binary = os.path.join(args.build_dir, "edgeslam")
+    os.makedirs(args.work, exist_ok=True)
+    source = os.path.join(args.shared, SOURCE)
+    pacing = "--" + args.pacing
+    sequences = plan(args.set, args.count, args.length)
+    if args.only:
+        wanted = {int(v) for v in args.only.split(",")}
+        sequences = [s for i, s in enumerate(sequences) if i in wanted]
+    started = time.monotonic()
+    rows = []
+    for seq in sequences:
+        dataset = generate(binary, args.shared, args.work, seq)
+        sensor = seq["sensor"]
+        static = run_once(binary, source, sensor, "local", "off", 0, ["--frames", seq["frames"]],
+                          pacing)
+        off = run_once(binary, dataset, sensor, "local", "off", 0, [], pacing)
+        on = run_once(binary, dataset, sensor, "local", "on", 0, [], pacing)
+        age = semantic(on, "mask_age_frames") or {}
+        row = dict(seq)
+        row.update({
+            "ate_static": ate_cm(static), "ate_off": ate_cm(off), "ate_on": ate_cm(on),
+            "tracked_static": static["tracked"], "tracked_off": off["tracked"],
+            "tracked_on": on["tracked"], "frames_run": on["frames"],
+            "iou": semantic(on, "mask_iou_median"),
+            "iou_keyframes": semantic(on, "mask_iou_keyframes_median"),
+            "precision": semantic(on, "culled_precision"),
+            "recall": semantic(on, "culled_recall"),
+            "mask_age_median": age.get("median"),
+            "seg_ms": (on.get("segmentation_ms") or {}).get("median"),
+            "extra_ms": (semantic(on, "client_ms") or {}).get("median"),
+        })
+        row["ratio_on"] = row["ate_on"] / row["ate_static"] if row["ate_static"] else None
+        row["ratio_off"] = row["ate_off"] / row["ate_static"] if row["ate_static"] else None
+        rows.append(row)
+        print(f"{seq['name']} {sensor} frames {seq['frames']} people {seq['people']} "
+              f"coverage {seq['coverage_median']:.2f}: IoU {fmt(row['iou'], '.2f')} "
+              f"(keyframes {fmt(row['iou_keyframes'], '.2f')}), precision "
+              f"{fmt(row['precision'], '.2f')} recall {fmt(row['recall'], '.2f')}, ATE static "
+              f"{row['ate_static']:.2f} off {row['ate_off']:.2f} on {row['ate_on']:.2f} cm "
+              f"(on/static {fmt(row['ratio_on'], '.2f')}, off/static {fmt(row['ratio_off'], '.2f')})",
+              flush=True)
+    elapsed = time.monotonic() - started
+
+    lines = [
+        f"Set `{args.set}` ({len(rows)} sequences of {args.length} frames, seeds "
+        f"{SET_SEEDS[args.set]}+), `--{args.pacing}`, local mode, one run per cell; "
+        f"`bench/semantic_spread_bench.py --set {args.set} --pacing {args.pacing}`, "
+        f"{elapsed / 60:.0f} min, {time.strftime('%Y-%m-%d')}.",
+        "",
+        "| sequence | sensor | frames | people | coverage median | walk m/s | mask IoU (non-kf / kf) "
+        "| culled precision / recall | ATE static / off / on cm | on / static | off / static "
+        "| tracked static / off / on | mask age median | seg ms | client extra ms |",
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        lines.append(
+            f"| {r['name']} | {r['sensor']} | {r['frames']} | {r['people']} | "
+            f"{100 * r['coverage_median']:.0f} % | {fmt(r['walk_speed'], '.1f')} | "
+            f"{fmt(r['iou'], '.2f')} / {fmt(r['iou_keyframes'], '.2f')} | "
+            f"{fmt(r['precision'], '.2f')} / {fmt(r['recall'], '.2f')} | "
+            f"{r['ate_static']:.2f} / {r['ate_off']:.2f} / {r['ate_on']:.2f} | "
+            f"{fmt(r['ratio_on'], '.2f')} | {fmt(r['ratio_off'], '.2f')} | "
+            f"{r['tracked_static']} / {r['tracked_off']} / {r['tracked_on']} of {r['frames_run']} | "
+            f"{fmt(r['mask_age_median'], '.0f')} | {fmt(r['seg_ms'], '.0f')} | "
+            f"{fmt(r['extra_ms'], '.2f')} |")
+    lines += ["", "| over | sequences | mask IoU non-kf median (worst) | kf median (worst) | "
+              "precision median | recall median (worst) | on / static median (worst) | "
+              "off / static median (worst) |", "|---|---|---|---|---|---|---|---|"]
+    for label, subset in [("all", rows), ("RGB-D", [r for r in rows if r["sensor"] == "rgbd"]),
+                          ("mono", [r for r in rows if r["sensor"] == "mono"])]:
+        if not subset:
+            continue
+        iou = distribution([r["iou"] for r in subset], min)
+        iou_kf = distribution([r["iou_keyframes"] for r in subset], min)
+        precision = distribution([r["precision"] for r in subset], min)
+        recall = distribution([r["recall"] for r in subset], min)
+        on = distribution([r["ratio_on"] for r in subset], max)
+        off = distribution([r["ratio_off"] for r in subset], max)
+        lines.append(
+            f"| {label} | {len(subset)} | {fmt(iou[0], '.2f')} ({fmt(iou[1], '.2f')}) | "
+            f"{fmt(iou_kf[0], '.2f')} ({fmt(iou_kf[1], '.2f')}) | {fmt(precision[0], '.2f')} | "
+            f"{fmt(recall[0], '.2f')} ({fmt(recall[1], '.2f')}) | {fmt(on[0], '.2f')} "
+            f"({fmt(on[1], '.2f')}) | {fmt(off[0], '.2f')} ({fmt(off[1], '.2f')}) |")
+    table = "\n".join(lines)
+    print()
+    print(table)
+    with open(os.path.join(args.work, f"{args.set}-{args.pacing}.json"), "w") as f:
+        json.dump(rows, f, indent=1)
+    if not args.no_docs and not args.only:
+        path = os.path.join(ROOT, "docs", "dynamic_benchmark.md")
+        with open(path) as f:
+            text = f.read()
+        marker = f"semantic-spread-{args.set}-{args.pacing}"
+        block = f"<!-- {marker} -->\n{table}\n<!-- /{marker} -->"
+        if f"<!-- {marker} -->" in text:
+            text = re.sub(rf"<!-- {marker} -->.*?<!-- /{marker} -->", lambda _: block, text,
+                          flags=re.S)
+        else:
+            text += f"\n### {args.set} set, --{args.pacing}\n\n{block}\n"
+        with open(path, "w") as f:
+            f.write(text)
+        print(f"wrote {path} ({marker})")
+
+
+if __name__ == "__main__":
+    main()
