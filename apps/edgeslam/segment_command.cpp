@@ -36,6 +36,7 @@ struct SegmentOptions {
   float nm = 0.8f;
   float score = 0.3f;
   float border_score = SegmenterOptions{}.border_score_threshold;
+  float other_score = SegmenterOptions{}.other_classes_score_threshold;
   int repeat = 1;
   int mask_downscale = 2;
   int threads = 0;
@@ -126,13 +127,14 @@ void runSegment(const SegmentOptions& o) {
   options.nms_threshold = o.nm;
   options.score_threshold = o.score;
   options.border_score_threshold = o.border_score;
+  options.other_classes_score_threshold = o.other_score;
   options.detector_input_size = o.input_size;
   const auto segmenter = makeSegmenter(options);
   fmt::print(
       "segmenter {} (models {}), classes {}, nm {:.2f}, score {:.2f} ({:.2f} at the image's "
-      "sides)\n",
+      "sides, {:.2f} for classes other than people)\n",
       segmenter->backendName(), options.model_dir.string(), classListToString(options.classes),
-      o.nm, o.score, o.border_score);
+      o.nm, o.score, o.border_score, o.other_score);
   if (!o.truth.empty()) {
     scoreSegmenterOnSequence(*segmenter, o.truth, {o.every, o.reduce});
     return;
@@ -188,6 +190,11 @@ void addSegmentCommand(CLI::App& app) {
       ->add_option("--border-score", options->border_score,
                    "Detection score threshold for boxes that reach the image's left or right "
                    "edge (people walking into view score lower)")
+      ->check(CLI::Range(0.0f, 1.0f))
+      ->capture_default_str();
+  segment
+      ->add_option("--other-score", options->other_score,
+                   "Detection score threshold for classes other than people, wherever the box is")
       ->check(CLI::Range(0.0f, 1.0f))
       ->capture_default_str();
   segment

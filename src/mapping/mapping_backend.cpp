@@ -223,6 +223,10 @@ void MappingBackend::waitUntilKeyFramesMapped() {
   if (segmentation_) segmentation_->waitUntilIdle();
 }
 
+void MappingBackend::waitUntilSegmented() {
+  if (segmentation_) segmentation_->waitUntilIdle();
+}
+
 void MappingBackend::waitUntilIdle() {
   if (segmentation_) segmentation_->waitUntilIdle();
   mapper_->waitUntilIdle();

@@ -116,6 +116,8 @@ class MappingBackend : public KeyFrameSink {
   void waitUntilKeyFramesMapped();
   // Until segmentation, mapping and loop closing (its global BA too) are all idle.
   void waitUntilIdle();
+  // Until every keyframe given to segmentation is segmented (its mask handed on).
+  void waitUntilSegmented();
 
   // Why one of the workers (mapping, loop closing, segmentation) ended with an exception: the
   // back end is then over. nullopt while they run.

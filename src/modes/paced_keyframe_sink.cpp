@@ -6,17 +6,19 @@ PacedKeyFrameSink::PacedKeyFrameSink(KeyFrameSink& inner, std::function<void()> 
     : inner_(inner), wait_until_idle_(std::move(wait_until_idle)) {}
 
 void PacedKeyFrameSink::insertKeyFrame(KeyFrame* keyframe) {
-  if (wait_until_idle_) {
-    Stopwatch waited;
-    wait_until_idle_();
-    const double ms = waited.elapsedMs();
-    if (ms >= kWaitedMs) {
-      MutexLock lock(mutex_);
-      waits_ms_.add(ms);
-      wait_total_ms_ += ms;
-    }
-  }
+  if (wait_until_idle_) waitFor(wait_until_idle_);
   inner_.insertKeyFrame(keyframe);
+}
+
+void PacedKeyFrameSink::waitFor(const std::function<void()>& wait) {
+  Stopwatch waited;
+  wait();
+  const double ms = waited.elapsedMs();
+  if (ms >= kWaitedMs) {
+    MutexLock lock(mutex_);
+    waits_ms_.add(ms);
+    wait_total_ms_ += ms;
+  }
 }
 
 bool PacedKeyFrameSink::acceptsKeyFrames() const {

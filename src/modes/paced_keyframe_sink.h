@@ -40,6 +40,8 @@ class PacedKeyFrameSink : public KeyFrameSink {
   void onMapReset() override { inner_.onMapReset(); }
 
   BackendPacing pacing() const;
+  // Another wait of tracking for the back end (counted with the keyframes' own).
+  void waitFor(const std::function<void()>& wait);
 
  private:
   // A wait this short found the back end idle already (a lock taken and released).

@@ -51,6 +51,10 @@ void TrackingSlam::startTracking(KeyFrameSink* sink, std::function<void()> wait_
   tracker_ = std::make_unique<Tracker>(map_, camera_, options_.tracker, sink);
 }
 
+void TrackingSlam::waitForBackend(const std::function<void()>& wait) {
+  if (options_.wait_for_backend && paced_sink_) paced_sink_->waitFor(wait);
+}
+
 void TrackingSlam::noteKeyFrameDepth(KeyFrameId id) {
   std::vector<double> depths;
   {

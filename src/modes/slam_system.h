@@ -192,6 +192,9 @@ class TrackingSlam : public SlamSystem {
   // `wait_until_idle` blocks until the back end has taken and finished every keyframe given to it;
   // tracking calls it before handing over the next keyframe when options_.wait_for_backend.
   void startTracking(KeyFrameSink* sink, std::function<void()> wait_until_idle = {});
+  // Offline pacing (options_.wait_for_backend): blocks on `wait`, counted as a wait for the back
+  // end; nothing otherwise.
+  void waitForBackend(const std::function<void()>& wait);
   // Before tracking a frame whose image is `image` (colour when given, else grey).
   virtual void beforeTracking(std::size_t /*frame_index*/, const cv::Mat& /*image*/) {}
   virtual void afterFrame() {}

@@ -120,9 +120,11 @@ std::vector<Detection> CenterNetDetector::detect(const cv::Mat& image,
         const double x1 = (cx + right(y, x) - box_input.offset.x) / box_input.scale;
         const double y1 = (cy + bottom(y, x) - box_input.offset.y) / box_input.scale;
         const bool at_border = x0 <= kBorderSlackPx || x1 >= bgr.cols - 1 - kBorderSlackPx;
-        if (score < (at_border ? options.border_score_threshold : options.score_threshold)) {
-          continue;
-        }
+        const float needed =
+            class_id != kCocoPerson
+                ? std::max(options.score_threshold, options.other_classes_score_threshold)
+                : (at_border ? options.border_score_threshold : options.score_threshold);
+        if (score < needed) continue;
         const cv::Rect2f box =
             cv::Rect2f(cv::Point2f(static_cast<float>(x0), static_cast<float>(y0)),
                        cv::Point2f(static_cast<float>(x1), static_cast<float>(y1))) &

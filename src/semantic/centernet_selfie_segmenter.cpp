@@ -11,8 +11,6 @@
 namespace edgeslam {
 namespace {
 
-constexpr int kPersonClass = 0;
-
 std::filesystem::path modelPath(const SegmenterOptions& options,
                                 const std::filesystem::path& explicit_path, const char* file) {
   return explicit_path.empty() ? options.model_dir / file : explicit_path;
@@ -47,6 +45,8 @@ CenterNetSelfieSegmenter::CenterNetSelfieSegmenter(const SegmenterOptions& optio
   setScoreThreshold(options.score_threshold);
   checkThreshold(options.border_score_threshold, "border score threshold");
   detector_options_.border_score_threshold = options.border_score_threshold;
+  checkThreshold(options.other_classes_score_threshold, "score threshold of other classes");
+  detector_options_.other_classes_score_threshold = options.other_classes_score_threshold;
   detector_options_.classes = options.classes.empty() ? defaultMovableClasses() : options.classes;
   if (options.detector_input_size < 64 || options.detector_input_size % 32 != 0) {
     throw std::invalid_argument("detector input size must be a multiple of 32 from 64, got " +
@@ -92,7 +92,7 @@ SegmentedInstance CenterNetSelfieSegmenter::maskInstance(const cv::Mat& bgr,
   if (instance.box.empty()) return instance;
   instance.mask(instance.box).setTo(255);
   instance.mask_is_box = true;
-  if (detection.class_id != kPersonClass) return instance;
+  if (detection.class_id != kCocoPerson) return instance;
 
   const float pad = options_.crop_padding;
   const cv::Rect2f padded(

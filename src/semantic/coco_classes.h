@@ -8,6 +8,7 @@
 namespace edgeslam {
 
 constexpr int kCocoClassCount = 80;
+constexpr int kCocoPerson = 0;
 
 // Name of a COCO class id; throws std::out_of_range for ids outside [0, 80).
 const std::string& cocoClassName(int class_id);

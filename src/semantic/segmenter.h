@@ -26,6 +26,8 @@ struct SegmenterOptions {
   // The same for detections whose box reaches the image's edge (people walking into view score
   // lower while only part of them shows).
   float border_score_threshold = 0.2f;
+  // Classes other than people, wherever their box is (the border threshold is for people).
+  float other_classes_score_threshold = 0.3f;
   float nms_threshold = 0.8f;      // box IoU above which the weaker same-class box is dropped (nm)
   std::vector<int> classes;        // COCO ids to segment; empty = defaultMovableClasses()
   float mask_threshold = 0.5f;     // person probability above which a pixel is in the mask

@@ -31,18 +31,18 @@ fs::path ownTempFolder(const std::string& name) {
 fs::path generate(const std::string& name, const std::string& options) {
   const fs::path out = ownTempFolder(name);
   fs::remove_all(out);
-  const auto r = test::runEdgeslam("synth-dynamic --dataset " +
-                                   test::sharedPath(kSequence).string() + " --out " +
-                                   out.string() + " " + options);
+  const auto r =
+      test::runEdgeslam("synth-dynamic --dataset " + test::sharedPath(kSequence).string() +
+                        " --out " + out.string() + " " + options);
   EXPECT_EQ(r.exit_code, 0) << r.output;
   return out;
 }
 
 nlohmann::json run(const fs::path& dataset, const std::string& sensor, const std::string& name) {
   const fs::path out = ownTempFolder(name);
-  const auto r = test::runEdgeslam("run --dataset " + dataset.string() + " --mode local --sensor " +
-                                   sensor + " --semantic on --fast --vocab none --out " +
-                                   out.string());
+  const auto r =
+      test::runEdgeslam("run --dataset " + dataset.string() + " --mode local --sensor " + sensor +
+                        " --semantic on --fast --vocab none --out " + out.string());
   EXPECT_EQ(r.exit_code, 0) << r.output;
   std::ifstream in(out / "metrics.json");
   if (!in) return {};
@@ -63,11 +63,12 @@ TEST(SemanticUnseenMotion, AMaskFollowsSomeoneCrossingCloseToTheCamera) {
   ASSERT_TRUE(m.contains("semantic")) << m.dump(2);
   const auto& s = m["semantic"];
   ASSERT_FALSE(s["mask_iou_median"].is_null()) << s.dump(2);
-  std::printf("close person, RGB-D --fast: mask IoU %.3f over %d frames, culled precision %.2f "
-              "recall %.2f, mask age median %s\n",
-              s["mask_iou_median"].get<double>(), s["mask_iou_frames"].get<int>(),
-              s["culled_precision"].get<double>(), s["culled_recall"].get<double>(),
-              s["mask_age_frames"]["median"].dump().c_str());
+  std::printf(
+      "close person, RGB-D --fast: mask IoU %.3f over %d frames, culled precision %.2f "
+      "recall %.2f, mask age median %s\n",
+      s["mask_iou_median"].get<double>(), s["mask_iou_frames"].get<int>(),
+      s["culled_precision"].get<double>(), s["culled_recall"].get<double>(),
+      s["mask_age_frames"]["median"].dump().c_str());
   EXPECT_GT(s["mask_iou_median"].get<double>(), 0.6);  // 0.2-0.3 when the mask stayed behind
   EXPECT_GT(s["culled_recall"].get<double>(), 0.6);
   EXPECT_GT(s["culled_precision"].get<double>(), 0.5);

@@ -190,6 +190,9 @@ TEST(SegmenterData, ACarPastedIntoAKitchenIsMaskedAndTheKitchenIsNot) {
 
   const Segmentation s = test::sharedSegmenter().segment(kitchen);
   expectConsistent(s, kitchen.size());
+  for (const auto& instance : s.instances) {
+    std::printf("pasted car: found %s %.2f\n", instance.class_name.c_str(), instance.score);
+  }
   const auto [found, iou] = bestMatch(s, "car", pasted);
   ASSERT_NE(found, nullptr) << s.instances.size() << " instances";
   EXPECT_GT(iou, 0.6);
