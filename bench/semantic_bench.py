@@ -97,13 +97,14 @@ def fmt(value, spec):
     return "-" if value is None else format(value, spec)
 
 
-def ensure_sequence(binary, shared, work, frames, seed):
-    out = os.path.join(work, f"7scenes-{frames}-seed{seed}")
+def ensure_sequence(binary, shared, work, frames, seed, name=None, extra=()):
+    """The generated sequence (reused when present); `extra`: more synth-dynamic options."""
+    out = os.path.join(work, name or f"7scenes-{frames}-seed{seed}")
     if os.path.exists(os.path.join(out, "masks.txt")):
         return out
     subprocess.run([binary, "synth-dynamic", "--dataset",
                     os.path.join(shared, "datasets/7scenes-redkitchen-1000"), "--out", out,
-                    "--frames", frames, "--seed", str(seed), "--overwrite"],
+                    "--frames", frames, "--seed", str(seed), "--overwrite"] + list(extra),
                    check=True, stdout=subprocess.DEVNULL)
     return out
 

@@ -20,12 +20,11 @@ import os
 import random
 import re
 import statistics
-import subprocess
 import sys
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from semantic_bench import ROOT, ate_cm, run_once  # noqa: E402
+from semantic_bench import ROOT, ate_cm, ensure_sequence, run_once  # noqa: E402
 
 SET_SEEDS = {"tuning": 1000, "report": 2000}
 SOURCE = "datasets/7scenes-redkitchen-1000"
@@ -50,12 +49,10 @@ def plan(set_name, count, length):
 
 
 def generate(binary, shared, work, seq):
-    out = os.path.join(work, f"{seq['name']}-seed{seq['seed']}")
-    if not os.path.exists(os.path.join(out, "masks.txt")):
-        subprocess.run([binary, "synth-dynamic", "--dataset", os.path.join(shared, SOURCE),
-                        "--out", out, "--frames", seq["frames"], "--seed", str(seq["seed"]),
-                        "--num-people", str(seq["people"]), "--coverage", str(seq["coverage"]),
-                        "--overwrite"], check=True, stdout=subprocess.DEVNULL)
+    out = ensure_sequence(binary, shared, work, seq["frames"], seq["seed"],
+                          name=f"{seq['name']}-seed{seq['seed']}",
+                          extra=["--num-people", str(seq["people"]),
+                                 "--coverage", str(seq["coverage"])])
     with open(os.path.join(out, "synth.json")) as f:
         synth = json.load(f)
     speeds = [

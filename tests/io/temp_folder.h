@@ -33,6 +33,13 @@ class TempFolder {
   std::filesystem::path path_;
 };
 
+// A folder of this test process's own, removed when it exits: ctest runs each test in its own
+// process, several at once.
+inline std::filesystem::path processTempFolder(const std::string& name) {
+  static const TempFolder scratch;
+  return scratch / name;
+}
+
 inline void writeText(const std::filesystem::path& path, const std::string& text) {
   std::filesystem::create_directories(path.parent_path());
   std::ofstream out(path);

@@ -19,16 +19,9 @@ namespace {
 namespace fs = std::filesystem;
 constexpr const char* kSequence = "datasets/7scenes-redkitchen-1000";
 
-// ctest runs each test in its own process, several at once: every folder is the process's own
-// (and removed when it exits).
-fs::path ownTempFolder(const std::string& name) {
-  static const test::TempFolder scratch;
-  return scratch / name;
-}
-
 const fs::path& dynamicSequence() {
   static const fs::path folder = [] {
-    const fs::path out = ownTempFolder("sequence");
+    const fs::path out = test::processTempFolder("sequence");
     fs::remove_all(out);
     const auto r =
         test::runEdgeslam("synth-dynamic --dataset " + test::sharedPath(kSequence).string() +
@@ -40,7 +33,7 @@ const fs::path& dynamicSequence() {
 }
 
 nlohmann::json runSemantic(const std::string& mode, const std::string& semantic) {
-  const fs::path out = ownTempFolder(mode + semantic);
+  const fs::path out = test::processTempFolder(mode + semantic);
   fs::remove_all(out);
   const auto r = test::runEdgeslam("run --dataset " + dynamicSequence().string() + " --mode " +
                                    mode + " --sensor rgbd --semantic " + semantic +

@@ -23,13 +23,8 @@ namespace {
 namespace fs = std::filesystem;
 constexpr const char* kSequence = "datasets/7scenes-redkitchen-1000";
 
-fs::path ownTempFolder(const std::string& name) {
-  static const test::TempFolder scratch;
-  return scratch / name;
-}
-
 fs::path generate(const std::string& name, const std::string& options) {
-  const fs::path out = ownTempFolder(name);
+  const fs::path out = test::processTempFolder(name);
   fs::remove_all(out);
   const auto r =
       test::runEdgeslam("synth-dynamic --dataset " + test::sharedPath(kSequence).string() +
@@ -39,7 +34,7 @@ fs::path generate(const std::string& name, const std::string& options) {
 }
 
 nlohmann::json run(const fs::path& dataset, const std::string& sensor, const std::string& name) {
-  const fs::path out = ownTempFolder(name);
+  const fs::path out = test::processTempFolder(name);
   const auto r =
       test::runEdgeslam("run --dataset " + dataset.string() + " --mode local --sensor " + sensor +
                         " --semantic on --fast --vocab none --out " + out.string());

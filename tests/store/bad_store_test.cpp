@@ -6,7 +6,6 @@
 #include <fstream>
 #include <iterator>
 
-#include "map/map_replication.h"
 #include "store/map_store.h"
 #include "store/store_error.h"
 #include "store/store_schema.h"
@@ -25,13 +24,7 @@ std::string readBytes(const std::filesystem::path& file) {
 // A store with one map, closed (checkpointed: the whole store in the one file).
 std::filesystem::path storeWithAMap(const std::string& name) {
   const auto dir = freshStoreDir(name);
-  test::SmallMap small;
-  MutexLock lock(small.map.updateMutex());
-  auto store = openMapStore(dir, MapStoreAccess::kServe);
-  MapStoreBatch batch;
-  for (const KeyFrame* kf : small.map.keyFrames()) batch.keyframes.push_back(keyFrameRecord(*kf));
-  for (const MapPoint* p : small.map.mapPoints()) batch.points.push_back(mapPointRecord(*p));
-  store->write(store->beginSession("m", small.info()), batch);
+  test::writeSmallMap(*openMapStore(dir, MapStoreAccess::kServe), "m");
   return dir;
 }
 

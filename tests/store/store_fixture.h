@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <string>
 
+#include "map/map_replication.h"
 #include "map/synthetic_views.h"
 #include "store/map_store.h"
 #include "store/map_store_writer.h"
@@ -46,5 +47,15 @@ struct SmallMap {
 
   StoredSessionInfo info() const { return {"test-client", scene.camera(), Sensor::kRgbd}; }
 };
+
+// A SmallMap written into `store` as map `name`, one session, in one batch.
+inline void writeSmallMap(MapStore& store, const std::string& name) {
+  SmallMap small;
+  MutexLock lock(small.map.updateMutex());
+  MapStoreBatch batch;
+  for (const KeyFrame* kf : small.map.keyFrames()) batch.keyframes.push_back(keyFrameRecord(*kf));
+  for (const MapPoint* p : small.map.mapPoints()) batch.points.push_back(mapPointRecord(*p));
+  store.write(store.beginSession(name, small.info()), batch);
+}
 
 }  // namespace edgeslam::test

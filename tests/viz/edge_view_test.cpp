@@ -7,7 +7,6 @@
 
 #include <nlohmann/json.hpp>
 
-#include "map/map_replication.h"
 #include "store/store_fixture.h"
 #include "viz/edge_map_json.h"
 
@@ -110,13 +109,8 @@ TEST(EdgeMapJson, OneTrajectoryPerClientAndLoopsAndMergesBetweenKeyFrames) {
 TEST(EdgeView, ListsTheStoresMapsAndShowsOneOnRequest) {
   const auto dir = test::freshStoreDir("edge_view");
   {
-    test::SmallMap small;
-    MutexLock lock(small.map.updateMutex());
     auto store = openMapStore(dir, MapStoreAccess::kServe);
-    MapStoreBatch batch;
-    for (const KeyFrame* kf : small.map.keyFrames()) batch.keyframes.push_back(keyFrameRecord(*kf));
-    for (const MapPoint* p : small.map.mapPoints()) batch.points.push_back(mapPointRecord(*p));
-    store->write(store->beginSession("kitchen", small.info()), batch);
+    test::writeSmallMap(*store, "kitchen");
     store->saveRoute("kitchen", walkRoute());
   }
   auto directory = std::make_shared<SessionDirectory>();
