@@ -27,10 +27,13 @@ struct FrameLogEntry {
   std::uint64_t downlink_bytes = 0;
   int adaptation_row = -1;  // Table I row in use (0-based); -1 without self-adaptation
   int features_culled = 0;  // by semantic culling in this frame
+  int features = 0;         // the extraction this frame had (zero where the client extracts none)
+  int levels = 0;
 };
 
 // Columns: frame,timestamp,state,keyframe,relocalized,tracked_points,load_ms,client_ms,e2e_ms,
-// features_ms,tracking_ms,keyframe_ms,uplink_bytes,downlink_bytes,adaptation_row,features_culled.
+// features_ms,tracking_ms,keyframe_ms,uplink_bytes,downlink_bytes,adaptation_row,features_culled,
+// features,levels.
 // Throws std::runtime_error naming the file when it cannot be written.
 void writeFrameLog(const std::filesystem::path& path, const std::vector<FrameLogEntry>& entries);
 

@@ -12,6 +12,7 @@
 #include "io/camera_file.h"
 #include "io/dataset.h"
 #include "io/frame_range.h"
+#include "io/preloaded_dataset.h"
 #include "io/repeated_dataset.h"
 #include "linkem/link_settings.h"
 #include "map_store_option.h"
@@ -23,6 +24,7 @@
 #include "modes/localization_slam.h"
 #include "modes/offload_slam.h"
 #include "place/vocabulary.h"
+#include "progress_line.h"
 #include "repeat_passes.h"
 #include "route_following.h"
 #include "run_frame_loop.h"
@@ -242,10 +244,35 @@ RunInput openRunInput(const RunOptions& options) {
                             .right = input.sensor == Sensor::kStereo});
   input.frame_count =
       options.max_frames > 0 ? std::min(options.max_frames, info.frame_count) : info.frame_count;
+  if (options.preload) {
+    ProgressLine progress;
+    const std::size_t count = input.frame_count;
+    input.reader = preloadFrames(std::move(input.reader), count, [&](std::size_t done) {
+      progress.update(fmt::format("preloading frame {}/{}", done, count), done == count);
+    });
+    progress.finish();
+  }
   spdlog::info("dataset {} ({}, {} frames, {} fps), camera {}", info.path.string(),
                toString(info.format), info.frame_count, info.fps,
                input.reader->camera().describe());
   return input;
+}
+
+// The client's cost fitted to its CPU: at the camera's pace only (`--fast` has no deadline), and
+// where the client extracts features (not offload).
+std::optional<ComputeBudgetOptions> computeBudgetFor(const RunOptions& options,
+                                                     const std::string& mode,
+                                                     const PinholeCamera& camera) {
+  if (!options.realtime || !options.compute_adapt || mode == "offload") return std::nullopt;
+  const double fps = camera.intrinsics().fps > 0.0 ? camera.intrinsics().fps : 30.0;
+  if ((options.features || options.levels) && options.realtime) {
+    spdlog::info(
+        "--compute-adapt on: --features and --levels are where the client starts; it lowers them "
+        "when frames do not fit the camera's period (--compute-adapt off keeps them)");
+  }
+  ComputeBudgetOptions budget;
+  budget.period_ms = 1000.0 / fps;
+  return budget;
 }
 
 // The run: the dataset, the mode's SLAM system (with its edge), the frames played through it with
@@ -303,11 +330,13 @@ int runPipeline(const RunOptions& given) {
                            .edge_map_size = [&edge] { return edge.sessionMapSize(); }};
 
   Stopwatch wall;
-  const PlayedFrames played = playFrames(*input.reader,
-                                         {.frame_count = input.frame_count,
-                                          .frames_per_pass = input.frames_per_pass,
-                                          .realtime = options.realtime},
-                                         slam, companions, wall);
+  const PlayedFrames played =
+      playFrames(*input.reader,
+                 {.frame_count = input.frame_count,
+                  .frames_per_pass = input.frames_per_pass,
+                  .realtime = options.realtime,
+                  .compute_budget = computeBudgetFor(options, mode, input.reader->camera())},
+                 slam, companions, wall);
   slam.finish();
   // What the edge's map store holds now (the last changes written first).
   nlohmann::json store_metrics = storeMetrics(edge.store, options.map_name);
@@ -378,12 +407,19 @@ void addRunOptions(CLI::App* run, const std::shared_ptr<RunOptions>& options) {
       ->capture_default_str();
   auto* max_frames =
       run->add_option("--max-frames", options->max_frames, "Process at most N frames (0 = all)");
-  run->add_option("--repeat", options->repeat,
-                  "Play the frames N times in a row into one map (the camera jumps back to the "
-                  "first frame at each pass); metrics.json \"passes\" has each pass's figures")
-      ->check(CLI::Range(1, 1000))
-      ->excludes(max_frames)
-      ->capture_default_str();
+  auto* repeat =
+      run->add_option("--repeat", options->repeat,
+                      "Play the frames N times in a row into one map (the camera jumps back to the "
+                      "first frame at each pass); metrics.json \"passes\" has each pass's figures")
+          ->check(CLI::Range(1, 1000))
+          ->excludes(max_frames)
+          ->capture_default_str();
+  run->add_flag("--preload", options->preload,
+                "Decode the frames to play into memory before the run starts, so that with "
+                "--realtime the client's CPU does not pay for reading the files (a device's "
+                "camera delivers decoded frames); refused when they would take more than half "
+                "of the available memory")
+      ->excludes(repeat);
   run->add_option_function<std::string>(
          "--frames",
          [options](const std::string& text) { options->frames = parseFrameRanges(text); },
@@ -414,6 +450,12 @@ void addRunOptions(CLI::App* run, const std::shared_ptr<RunOptions>& options) {
       });
   auto* realtime = run->add_flag("--realtime", options->realtime,
                                  "Feed frames at the dataset's rate, dropping none");
+  run->add_option("--compute-adapt", options->compute_adapt,
+                  "With --realtime: when frames take longer than the camera's period, the "
+                  "client extracts fewer features, then fewer pyramid levels, and returns to "
+                  "the configuration once there is room (on|off; metrics.json compute_budget)")
+      ->transform(
+          CLI::CheckedTransformer(std::map<std::string, bool>{{"on", true}, {"off", false}}));
   run->add_flag("--fast", options->fast, "Feed frames as fast as possible (the default)")
       ->excludes(realtime);
   run->add_flag("--deterministic", options->deterministic,

@@ -81,6 +81,15 @@ void publishToViewer(RunCompanions& companions, const FrameLogEntry& logged, dou
                                   slam.lastSemanticFrame());
 }
 
+void fitExtractionToTheCpu(const ComputeBudget& budget, SlamSystem& slam, std::size_t frame) {
+  const std::pair<int, int> before = slam.extractionSize();
+  slam.setComputeStep(budget.current());
+  const std::pair<int, int> after = slam.extractionSize();
+  spdlog::info("compute budget: {} at frame {}: {} features, {} pyramid levels (were {}, {})",
+               after.first < before.first ? "frames do not fit the camera's period" : "room again",
+               frame, after.first, after.second, before.first, before.second);
+}
+
 }  // namespace
 
 PlayedFrames playFrames(DatasetReader& reader, const FramePlan& plan, SlamSystem& slam,
@@ -102,6 +111,11 @@ PlayedFrames playFrames(DatasetReader& reader, const FramePlan& plan, SlamSystem
                                         .sleep_ms = steadyLiveCameraClock().sleep_ms},
                         LiveCameraOptions{.extra_load_ms = testExtraLoadMs()});
   }
+  played.configured_extraction = slam.extractionSize();
+  if (plan.compute_budget && slam.setComputeStep(computeSteps()[0])) {
+    played.compute_budget.emplace(*plan.compute_budget);
+  }
+  std::size_t skipped_before = 0;
   PassLog* pass_log = companions.pass_log;
   RouteFollowing* route = companions.route;
   std::size_t next_unpaced = 0;
@@ -118,6 +132,7 @@ PlayedFrames playFrames(DatasetReader& reader, const FramePlan& plan, SlamSystem
       i = live->index;
       due_ms = live->due_ms;
       played.load_ms.add(live->load_ms);
+      skipped_before = live->skipped;
       frame = std::move(live->frame);
     } else {
       if (next_unpaced >= plan.frame_count) break;
@@ -134,6 +149,7 @@ PlayedFrames playFrames(DatasetReader& reader, const FramePlan& plan, SlamSystem
       continue;
     }
     if (frame.ground_truth) played.ground_truth.push_back({frame.timestamp, *frame.ground_truth});
+    const std::pair<int, int> extraction = slam.extractionSize();
     Stopwatch frame_timer;
     TrackResult result = slam.process(i, frame.timestamp, frame.gray, frame.depth, frame.color);
     const double processing_ms = frame_timer.elapsedMs();
@@ -147,11 +163,16 @@ PlayedFrames playFrames(DatasetReader& reader, const FramePlan& plan, SlamSystem
                       result.state == TrackingState::kOk ? result.T_cw : std::nullopt);
     }
     played.client_ms.add(processing_ms);
+    if (played.compute_budget && played.compute_budget->onFrame(processing_ms, skipped_before)) {
+      fitExtractionToTheCpu(*played.compute_budget, slam, i);
+    }
     double frame_e2e_ms = processing_ms;
     if (live_camera) frame_e2e_ms = std::max(processing_ms, wall.elapsedMs() - due_ms);
     played.e2e_ms.add(frame_e2e_ms);
     played.frame_log.push_back(logEntry(i, frame.timestamp, result, played.load_ms.samples().back(),
                                         processing_ms, frame_e2e_ms, slam));
+    played.frame_log.back().features = extraction.first;
+    played.frame_log.back().levels = extraction.second;
     if (result.state == TrackingState::kOk) {
       ++played.tracked;
     } else if (result.state == TrackingState::kLost) {

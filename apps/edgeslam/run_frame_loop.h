@@ -5,8 +5,10 @@
 #include <cstddef>
 #include <functional>
 #include <optional>
+#include <utility>
 #include <vector>
 
+#include "adapt/compute_budget.h"
 #include "frame_log.h"
 #include "io/dataset.h"
 #include "io/frame_order_guard.h"
@@ -26,6 +28,8 @@ struct FramePlan {
   std::size_t frame_count = 0;      // frames to play (all passes)
   std::size_t frames_per_pass = 0;  // of the selected range, before --repeat
   bool realtime = false;
+  // The client's per-frame work fitted to its CPU (with realtime; adapt/compute_budget.h).
+  std::optional<ComputeBudgetOptions> compute_budget;
 };
 
 // Optional parts that watch the frames go by; each may be absent.
@@ -53,6 +57,10 @@ struct PlayedFrames {
   std::size_t frames_skipped_late = 0;
   std::size_t frames_read = 0;
   std::size_t frames_read_unused = 0;
+  // What the compute budget did, when there was one; `configured` is the extraction it started
+  // from (features, levels).
+  std::optional<ComputeBudget> compute_budget;
+  std::pair<int, int> configured_extraction{0, 0};
 };
 
 // Plays the frames; `wall` is the run's clock (started before the first frame).

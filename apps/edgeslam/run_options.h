@@ -22,6 +22,9 @@ struct RunOptions {
   std::string maps;                // the embedded edge's map store: "" = default, "none" = none
   std::string map_name;            // the edge map this session writes into; "" = a new one
   bool adapt = true;
+  // With --realtime: the client fits its per-frame work to its CPU (adapt/compute_budget.h).
+  bool compute_adapt = true;
+  bool preload = false;  // decode the frames to play before the run (io/preloaded_dataset.h)
   bool semantic = false;
   std::filesystem::path models_dir;  // segmentation models; "" = the shared models folder
   int segment_input = 256;           // detector input side

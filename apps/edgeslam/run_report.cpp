@@ -214,6 +214,7 @@ void RunReport::addModeMetrics() {
                                    {"tracking", toJson(stages.tracking_ms)},
                                    {"keyframe", toJson(stages.keyframe_ms)}};
   }
+  if (played_.compute_budget) metrics["compute_budget"] = computeBudgetJson();
   const EdgeExchangeCounters& exchange = counters_.exchange;
   if (const AdaptationLoop* adaptation = slam_.adaptation()) {
     metrics["adapt"] = adaptationJson(*adaptation);
@@ -347,6 +348,7 @@ void RunReport::printSummary() const {
         store_metrics_["bytes_per_keyframe"].get<std::uint64_t>(),
         store_metrics_["write_ms"]["median"].get<double>());
   }
+  if (played_.compute_budget) fmt::print("  compute      {}\n", computeBudgetLine());
   const BackendPacing& backend = counters_.backend;
   if (backend.waits > 0 || played_.frames_skipped_late > 0) {
     fmt::print(
@@ -356,6 +358,66 @@ void RunReport::printSummary() const {
         played_.frames_skipped_late);
   }
   for (const std::string& warning : warnings_) fmt::print("  WARNING      {}\n", warning);
+}
+
+namespace {
+
+// The extraction frames actually had (the compute budget's steps, and Table I's pyramid in edge
+// mode): the least features and levels, and the last frame's.
+struct ExtractionSeen {
+  int least_features = 0, least_levels = 0;
+  int final_features = 0, final_levels = 0;
+  std::size_t frames_reduced = 0;  // with fewer features than configured
+};
+
+ExtractionSeen extractionSeen(const std::vector<FrameLogEntry>& log, int configured_features) {
+  ExtractionSeen seen;
+  for (const FrameLogEntry& entry : log) {
+    if (entry.features <= 0) continue;
+    if (seen.least_features == 0 || entry.features < seen.least_features) {
+      seen.least_features = entry.features;
+    }
+    if (seen.least_levels == 0 || entry.levels < seen.least_levels) {
+      seen.least_levels = entry.levels;
+    }
+    seen.final_features = entry.features;
+    seen.final_levels = entry.levels;
+    if (entry.features < configured_features) ++seen.frames_reduced;
+  }
+  return seen;
+}
+
+}  // namespace
+
+nlohmann::json RunReport::computeBudgetJson() const {
+  const ComputeBudget& budget = *played_.compute_budget;
+  const auto [features, levels] = played_.configured_extraction;
+  const ExtractionSeen seen = extractionSeen(played_.frame_log, features);
+  return {{"period_ms", budget.options().period_ms},
+          {"frames_per_step", budget.framesPerStep()},
+          {"switches", budget.switches()},
+          {"deepest_step", budget.deepestStep()},
+          {"final_step", budget.step()},
+          {"frames_with_fewer_features", seen.frames_reduced},
+          {"configured", {{"features", features}, {"levels", levels}}},
+          {"least", {{"features", seen.least_features}, {"levels", seen.least_levels}}},
+          {"final", {{"features", seen.final_features}, {"levels", seen.final_levels}}}};
+}
+
+std::string RunReport::computeBudgetLine() const {
+  const ComputeBudget& budget = *played_.compute_budget;
+  const auto [features, levels] = played_.configured_extraction;
+  if (budget.deepestStep() == 0) {
+    return fmt::format("frames fit the camera's period ({:.1f} ms): {} features kept",
+                       budget.options().period_ms, features);
+  }
+  const ExtractionSeen seen = extractionSeen(played_.frame_log, features);
+  return fmt::format(
+      "fitted to the CPU ({:.1f} ms a frame): {} of {} frames with fewer features, at the least "
+      "{} features and {} levels (configured {} and {}); {} switches, ending at {} and {}",
+      budget.options().period_ms, seen.frames_reduced, played_.frame_log.size(),
+      seen.least_features, seen.least_levels, features, levels, budget.switches(),
+      seen.final_features, seen.final_levels);
 }
 
 void RunReport::writeOutputs() const {

@@ -39,6 +39,8 @@ class RunReport {
  private:
   nlohmann::json commonMetrics() const;
   void addModeMetrics();
+  nlohmann::json computeBudgetJson() const;
+  std::string computeBudgetLine() const;
 
   const RunSetup& setup_;
   const PlayedFrames& played_;

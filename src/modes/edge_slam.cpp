@@ -156,7 +156,7 @@ void EdgeSlam::applyConfiguration(const KeyframeConfig& config) {
   setKeyFrameGaps(kf, config.fmin, config.fmax, camera_.intrinsics().fps);
   kf.alpha = config.alpha;
   kf.beta = config.beta;
-  extractor_.setNumLevels(config.pyramid_levels);
+  setPyramidLevels(config.pyramid_levels);
   sink_->setSegmenterNms(static_cast<float>(config.nms_threshold));
   spdlog::info(
       "adaptation: keyframes fmin {} fmax {} alpha {} beta {}, {} pyramid levels, segmenter nm {}",

@@ -27,7 +27,11 @@ SlamOptions defaultSlamOptions(const PinholeCamera& camera, Sensor sensor) {
 
 TrackingSlam::TrackingSlam(const PinholeCamera& camera, SlamOptions options,
                            std::uint8_t map_id_origin)
-    : camera_(camera), options_(std::move(options)), extractor_(options_.orb), map_(map_id_origin) {
+    : camera_(camera),
+      options_(std::move(options)),
+      extractor_(options_.orb),
+      map_(map_id_origin),
+      levels_wanted_(options_.orb.num_levels) {
   options_.tracker.sensor = options_.sensor;
   if (options_.semantic) {
     semantic_filter_ = std::make_unique<SemanticFrameFilter>(camera_, options_.semantic_filter);
@@ -49,6 +53,24 @@ void TrackingSlam::startTracking(KeyFrameSink* sink, std::function<void()> wait_
     sink = paced_sink_.get();
   }
   tracker_ = std::make_unique<Tracker>(map_, camera_, options_.tracker, sink);
+}
+
+bool TrackingSlam::setComputeStep(const ComputeStep& step) {
+  compute_step_ = step;
+  applyExtractionSize();
+  return true;
+}
+
+void TrackingSlam::setPyramidLevels(int levels) {
+  levels_wanted_ = levels;
+  applyExtractionSize();
+}
+
+void TrackingSlam::applyExtractionSize() {
+  const int features = compute_step_.features(options_.orb.num_features);
+  const int levels = compute_step_.levels(levels_wanted_);
+  if (features != extractor_.options().num_features) extractor_.setNumFeatures(features);
+  if (levels != extractor_.numLevels()) extractor_.setNumLevels(levels);
 }
 
 void TrackingSlam::waitForBackend(const std::function<void()>& wait) {

@@ -7,8 +7,10 @@
 #include <memory>
 #include <opencv2/core.hpp>
 #include <optional>
+#include <utility>
 #include <vector>
 
+#include "adapt/compute_budget.h"
 #include "client/segmentation_refresh.h"
 #include "client/semantic_frame_filter.h"
 #include "client/tracker.h"
@@ -147,6 +149,12 @@ class SlamSystem {
   virtual const SemanticFrame* lastSemanticFrame() const { return nullptr; }
   virtual ClientStageTimes lastFrameStages() const { return {}; }
 
+  // The client's cost fitted to its CPU (adapt/compute_budget.h): the extraction of the frames
+  // after this one follows `step`. False where the client extracts nothing (offload).
+  virtual bool setComputeStep(const ComputeStep& /*step*/) { return false; }
+  // Features and pyramid levels the next frame is extracted with (0, 0 where none).
+  virtual std::pair<int, int> extractionSize() const { return {0, 0}; }
+
   // What a mode alone has; absent elsewhere. The loop that retunes the keyframe rules to the link
   // (edge mode with adaptation):
   virtual const AdaptationLoop* adaptation() const { return nullptr; }
@@ -182,6 +190,10 @@ class TrackingSlam : public SlamSystem {
   // Always present: without semantic culling, every feature is kept and there is no mask.
   const SemanticFrame* lastSemanticFrame() const override { return &last_semantic_; }
   ClientStageTimes lastFrameStages() const override { return last_stages_; }
+  bool setComputeStep(const ComputeStep& step) override;
+  std::pair<int, int> extractionSize() const override {
+    return {extractor_.options().num_features, extractor_.numLevels()};
+  }
 
   const Tracker& tracker() const { return *tracker_; }
   // The client's map (lock its update mutex while reading it during a run).
@@ -206,6 +218,8 @@ class TrackingSlam : public SlamSystem {
   }
   // The semantic stage's and the per-stage timing figures, for the subclasses' counters().
   void addClientCounters(SlamCounters& counters) const;
+  // The pyramid the mode asks for (edge mode: Table I's row); the compute step may cap it.
+  void setPyramidLevels(int levels);
 
   PinholeCamera camera_;
   SlamOptions options_;
@@ -225,6 +239,10 @@ class TrackingSlam : public SlamSystem {
   double keyFrameDepthRatio() const;
   static constexpr std::size_t kMinPointsForDepth = 20;
   static constexpr std::size_t kMinKeyFramesPerQuarter = 5;
+
+  void applyExtractionSize();
+  int levels_wanted_ = 0;  // of the mode; features: options_.orb.num_features
+  ComputeStep compute_step_;
 
   std::unique_ptr<PacedKeyFrameSink> paced_sink_;
   std::vector<double> keyframe_depths_;  // monocular: each keyframe's median point depth
