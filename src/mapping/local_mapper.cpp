@@ -107,10 +107,12 @@ void LocalMapper::releaseErased() {
 
 void LocalMapper::processKeyFrame(KeyFrame* keyframe) {
   failpoint("local_mapping");
+  const Stopwatch timer;
   mapKeyFrame(keyframe);
   {
     MutexLock lock(stats_mutex_);
     ++stats_.keyframes_processed;
+    stats_.keyframe_ms.add(timer.elapsedMs());
   }
   if (on_mapped_) on_mapped_(keyframe);
 }
@@ -161,9 +163,11 @@ void LocalMapper::mapKeyFrame(KeyFrame* keyframe) {
       enough_keyframes = map_.keyFrameCount() > 2 && !keyframe->isBad();
     }
     if (enough_keyframes && options_.run_local_ba) {
+      const Stopwatch ba_timer;
       localBundleAdjustment(map_, keyframe, camera_, queue_.giveWay());
       MutexLock lock(stats_mutex_);
       ++stats_.local_ba_runs;
+      stats_.local_ba_ms.add(ba_timer.elapsedMs());
     }
     if (options_.cull_keyframes) cullKeyFrames(keyframe);
   }

@@ -21,6 +21,7 @@
 #include "util/mutex.h"
 #include "util/queued_worker.h"
 #include "util/thread_annotations.h"
+#include "util/timing_stats.h"
 
 namespace edgeslam {
 
@@ -86,6 +87,9 @@ struct LocalMapperStats {
   std::size_t triangulation_bow_searches = 0;
   std::size_t triangulation_pairs = 0;
   double triangulation_search_ms = 0.0;
+  // Wall time of mapping each keyframe (waits for the map's lock included), and of its local BA.
+  SampleStats keyframe_ms;
+  SampleStats local_ba_ms;
 };
 
 // Of a keyframe's points (with depth: its close points), those seen at the same or a finer scale

@@ -113,6 +113,7 @@ void LoopCloser::processKeyFrame(KeyFrame* keyframe) {
       MutexLock lock(map_.updateMutex());
       if (keyframe->isBad()) return;
     }
+    const Stopwatch detection_timer;
     detector_.describe(*keyframe);  // the features never change: no lock needed
     ++keyframes_since_loop_;
     LoopVerification verification;
@@ -142,6 +143,7 @@ void LoopCloser::processKeyFrame(KeyFrame* keyframe) {
       MutexLock lock(stats_mutex_);
       ++stats_.keyframes_processed;
       if (verified_any) ++stats_.keyframes_with_candidates;
+      stats_.detection_ms.add(detection_timer.elapsedMs());
     }
     if (verification.loop) closeLoop(*verification.loop);
   } catch (const std::exception& e) {
@@ -208,7 +210,7 @@ void LoopCloser::closeLoop(const VerifiedLoop& loop) {
   }
   ++loops_;
   if (on_corrected_) on_corrected_();
-  if (options_.global_ba) launchGlobalBundleAdjustment();
+  if (options_.global_ba) launchGlobalBundleAdjustment(event.current);
 }
 
 void LoopCloser::stopGlobalBundleAdjustment() {
@@ -218,7 +220,7 @@ void LoopCloser::stopGlobalBundleAdjustment() {
   global_ba_thread_.join();
 }
 
-void LoopCloser::launchGlobalBundleAdjustment() {
+void LoopCloser::launchGlobalBundleAdjustment(KeyFrameId loop_keyframe) {
   {
     MutexLock lock(stats_mutex_);
     ++stats_.global_ba_started;
@@ -226,17 +228,22 @@ void LoopCloser::launchGlobalBundleAdjustment() {
   MutexLock lock(global_ba_mutex_);
   cancel_global_ba_ = false;
   if (options_.threaded) {
-    global_ba_thread_.start("global bundle adjustment", [this] {
+    global_ba_thread_.start("global bundle adjustment", [this, loop_keyframe] {
       MapParticipant participant(map_, "global bundle adjustment");
-      globalBundleAdjustment();
+      globalBundleAdjustment(loop_keyframe);
     });
   } else {
-    globalBundleAdjustment();
+    globalBundleAdjustment(loop_keyframe);
   }
 }
 
-void LoopCloser::globalBundleAdjustment() {
+void LoopCloser::globalBundleAdjustment(KeyFrameId loop_keyframe) {
   Stopwatch timer;
+  const KeyFrame* seed = nullptr;
+  {
+    MutexLock lock(map_.updateMutex());
+    seed = map_.keyFrame(loop_keyframe);  // culled meanwhile: the whole map
+  }
   GlobalBundleAdjustmentHooks hooks;
   if (mapper_ != nullptr) {
     hooks.before_apply = [this] { mapper_->pause(); };
@@ -245,7 +252,8 @@ void LoopCloser::globalBundleAdjustment() {
   LoopGlobalBundleAdjustmentResult result;
   try {
     result = runLoopGlobalBundleAdjustment(map_, camera_, &cancel_global_ba_,
-                                           options_.global_ba_iterations, hooks);
+                                           options_.global_ba_iterations, hooks, seed,
+                                           options_.global_ba_max_keyframes);
   } catch (const std::exception& e) {
     spdlog::error("global bundle adjustment failed: {}", e.what());
     return;
@@ -258,7 +266,16 @@ void LoopCloser::globalBundleAdjustment() {
       stats_.global_ba_ms.push_back(elapsed_ms);
     } else if (result.cancelled) {
       ++stats_.global_ba_cancelled;
+    } else if (result.too_large) {
+      ++stats_.global_ba_too_large;
     }
+  }
+  if (result.too_large) {
+    spdlog::info(
+        "global bundle adjustment skipped: the loop's part of the map has {} keyframes (more than "
+        "{}); the essential graph's correction stands",
+        result.keyframes, options_.global_ba_max_keyframes);
+    return;
   }
   if (result.cancelled) {
     spdlog::info("global bundle adjustment abandoned after {:.0f} ms", elapsed_ms);

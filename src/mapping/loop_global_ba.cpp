@@ -1,6 +1,8 @@
 #include "mapping/loop_global_ba.h"
 
+#include <algorithm>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "mapping/loop_map_correction.h"
@@ -9,9 +11,30 @@
 
 namespace edgeslam {
 
+std::vector<KeyFrame*> connectedKeyFrames(const Map& map, const KeyFrame* seed) {
+  std::vector<KeyFrame*> part;
+  if (seed == nullptr || seed->isBad()) return part;
+  KeyFrame* start = map.keyFrame(seed->id());
+  if (start == nullptr) return part;
+  std::unordered_set<const KeyFrame*> seen{start};
+  std::unordered_set<const MapPoint*> points_seen;
+  part.push_back(start);
+  for (std::size_t next = 0; next < part.size(); ++next) {
+    for (MapPoint* p : part[next]->goodPoints()) {
+      if (!points_seen.insert(p).second) continue;
+      for (const auto& [id, obs] : p->observations()) {
+        if (obs.keyframe->isBad() || !seen.insert(obs.keyframe).second) continue;
+        part.push_back(obs.keyframe);
+      }
+    }
+  }
+  return part;
+}
+
 LoopGlobalBundleAdjustmentResult runLoopGlobalBundleAdjustment(
     Map& map, const PinholeCamera& camera, const std::atomic<bool>* cancel, int iterations,
-    const GlobalBundleAdjustmentHooks& hooks) {
+    const GlobalBundleAdjustmentHooks& hooks, const KeyFrame* loop_keyframe,
+    std::size_t max_keyframes) {
   LoopGlobalBundleAdjustmentResult result;
   BundleAdjustmentProblem problem;
   std::vector<KeyFrame*> keyframes;
@@ -19,14 +42,39 @@ LoopGlobalBundleAdjustmentResult runLoopGlobalBundleAdjustment(
   std::vector<std::pair<KeyFrame*, MapPoint*>> owners;  // per observation
   {
     MutexLock lock(map.updateMutex());
-    keyframes = map.keyFrames();
+    keyframes = loop_keyframe != nullptr ? connectedKeyFrames(map, loop_keyframe) : map.keyFrames();
     if (keyframes.size() < 2) return result;
+    if (max_keyframes > 0 && keyframes.size() > max_keyframes) {
+      result.keyframes = keyframes.size();
+      result.too_large = true;
+      return result;
+    }
+    std::sort(keyframes.begin(), keyframes.end(),
+              [](const KeyFrame* a, const KeyFrame* b) { return a->id() < b->id(); });
+    // The gauge: the map's origin where the part holds it, else the part's oldest keyframe.
+    const KeyFrame* fixed = keyframes.front();
+    for (const KeyFrame* kf : keyframes) {
+      if (kf == map.originKeyFrame()) fixed = kf;
+    }
     std::unordered_map<const KeyFrame*, std::size_t> keyframe_index;
     for (KeyFrame* kf : keyframes) {
       keyframe_index.emplace(kf, problem.keyframes.size());
-      problem.keyframes.push_back({kf->id(), kf->pose(), kf == map.originKeyFrame()});
+      problem.keyframes.push_back({kf->id(), kf->pose(), kf == fixed});
     }
-    for (MapPoint* p : map.mapPoints()) {
+    std::vector<MapPoint*> candidates;
+    if (loop_keyframe != nullptr) {
+      std::unordered_set<MapPoint*> unique;
+      for (KeyFrame* kf : keyframes) {
+        for (MapPoint* p : kf->goodPoints()) {
+          if (unique.insert(p).second) candidates.push_back(p);
+        }
+      }
+      std::sort(candidates.begin(), candidates.end(),
+                [](const MapPoint* a, const MapPoint* b) { return a->id() < b->id(); });
+    } else {
+      candidates = map.mapPoints();
+    }
+    for (MapPoint* p : candidates) {
       if (p->isBad()) continue;
       const std::size_t point_index = points.size();
       bool observed = false;
