@@ -15,7 +15,7 @@ export EDGESLAM_SHARED
 export CCACHE_BASEDIR ?= $(CURDIR)
 
 .PHONY: all deps configure build vocab test test-release test-sanitize test-tsan test-host-timing demo bench format format-check clean
-.PHONY: fuzz sanitize-build
+.PHONY: fuzz sanitize-build bench-scale
 
 all: build
 
@@ -95,6 +95,16 @@ bench: build
 	@python3 bench/slam_bench.py --build $(BUILD_DIR) --shared $(EDGESLAM_SHARED) --modes local,edge,offload
 	@python3 bench/link_experiments.py --build-dir $(BUILD_DIR)
 	@python3 bench/semantic_bench.py --build-dir $(BUILD_DIR) --shared $(EDGESLAM_SHARED)
+
+# Cost at scale (issue 25; about 1.5 h on this 2-core machine, best on a quiet one): the client's
+# stages against their floors, the client under a CPU quota (local against edge mode, compute
+# adaptation on and off), cost against map size (100 to 10,000 keyframes), 1-8 clients on one server.
+# Tables into docs/benchmarks.md, plots into docs/figures.
+bench-scale: vocab
+	@python3 bench/client_stages_bench.py --build $(BUILD_DIR) --shared $(EDGESLAM_SHARED)
+	@python3 bench/weak_device_bench.py --build $(BUILD_DIR) --shared $(EDGESLAM_SHARED)
+	@python3 bench/map_scale_bench.py --build $(BUILD_DIR) --shared $(EDGESLAM_SHARED)
+	@python3 bench/clients_bench.py --build $(BUILD_DIR) --shared $(EDGESLAM_SHARED)
 
 format:
 	@git ls-files '*.cpp' '*.h' | xargs clang-format -i

@@ -35,6 +35,8 @@ void extractOurs(benchmark::State& state, const char* relative) {
   if (image.empty()) return;
   OrbExtractorOptions options;
   options.num_features = static_cast<int>(state.range(0));
+  // A second argument: the pyramid's levels (the client's compute budget lowers both).
+  if (state.range(1) > 0) options.num_levels = static_cast<int>(state.range(1));
   OrbExtractor extractor(options);
   std::vector<cv::KeyPoint> keypoints;
   cv::Mat descriptors;
@@ -181,13 +183,73 @@ void BM_MatchBruteForce_7Scenes(benchmark::State& state) {
   state.counters["matches"] = static_cast<double>(matches);
 }
 
+// Floors of the extraction on this machine: what any ORB extractor of 8 levels at scale 1.2 must
+// do at least, with OpenCV's (vectorised) primitives: build the pyramid, detect FAST corners on
+// every level (one threshold, no cells, no retry), blur each level for the descriptors. Describing
+// is BM_Describe_CvOrbCompute's.
+std::vector<cv::Mat> pyramidOf(const cv::Mat& image, int levels) {
+  std::vector<cv::Mat> pyramid{image};
+  double scale = 1.0;
+  for (int level = 1; level < levels; ++level) {
+    scale *= 1.2;
+    cv::Mat next;
+    cv::resize(image, next, cv::Size(cvRound(image.cols / scale), cvRound(image.rows / scale)), 0,
+               0, cv::INTER_LINEAR);
+    pyramid.push_back(std::move(next));
+  }
+  return pyramid;
+}
+
+void BM_Floor_Pyramid_7Scenes(benchmark::State& state) {
+  const cv::Mat image = loadGrey(state, kSevenScenes);
+  if (image.empty()) return;
+  for (auto _ : state) {
+    auto pyramid = pyramidOf(image, 8);
+    benchmark::DoNotOptimize(pyramid.back().data);
+  }
+}
+
+void BM_Floor_PyramidFast_7Scenes(benchmark::State& state) {
+  const cv::Mat image = loadGrey(state, kSevenScenes);
+  if (image.empty()) return;
+  std::vector<cv::KeyPoint> keypoints;
+  std::size_t found = 0;
+  for (auto _ : state) {
+    found = 0;
+    for (const cv::Mat& level : pyramidOf(image, 8)) {
+      cv::FAST(level, keypoints, 20, true);
+      found += keypoints.size();
+    }
+    benchmark::DoNotOptimize(found);
+  }
+  state.counters["corners"] = static_cast<double>(found);
+}
+
+void BM_Floor_PyramidBlur_7Scenes(benchmark::State& state) {
+  const cv::Mat image = loadGrey(state, kSevenScenes);
+  if (image.empty()) return;
+  cv::Mat blurred;
+  for (auto _ : state) {
+    for (const cv::Mat& level : pyramidOf(image, 8)) {
+      cv::GaussianBlur(level, blurred, cv::Size(7, 7), 2.0, 2.0, cv::BORDER_REFLECT_101);
+      benchmark::DoNotOptimize(blurred.data);
+    }
+  }
+}
+
 void configure(benchmark::internal::Benchmark* b) {
   b->Unit(benchmark::kMillisecond)->UseRealTime()->Repetitions(5)->ReportAggregatesOnly(true);
 }
 
-BENCHMARK(BM_OrbExtract_7Scenes)->Arg(1000)->Apply(configure);
+// The client's compute budget's steps (adapt/compute_budget.h): features and levels.
+BENCHMARK(BM_OrbExtract_7Scenes)
+    ->Args({1000, 8})
+    ->Args({800, 8})
+    ->Args({700, 6})
+    ->Args({600, 5})
+    ->Apply(configure);
 BENCHMARK(BM_CvOrb_7Scenes)->Arg(1000)->Apply(configure);
-BENCHMARK(BM_OrbExtract_Kitti)->Arg(2000)->Apply(configure);
+BENCHMARK(BM_OrbExtract_Kitti)->Args({2000, 0})->Apply(configure);
 BENCHMARK(BM_CvOrb_Kitti)->Arg(2000)->Apply(configure);
 // Second argument: the retry threshold (0: the default 7; 20: no retry in empty cells).
 BENCHMARK(BM_OrbExtract_KittiSequence)->Args({2000, 0})->Args({2000, 20})->Apply(configure);
@@ -196,6 +258,9 @@ BENCHMARK(BM_Describe_SteeredBrief)->Apply(configure);
 BENCHMARK(BM_Describe_CvOrbCompute)->Apply(configure);
 BENCHMARK(BM_MatchInWindow_7Scenes)->Apply(configure);
 BENCHMARK(BM_MatchBruteForce_7Scenes)->Apply(configure);
+BENCHMARK(BM_Floor_Pyramid_7Scenes)->Apply(configure);
+BENCHMARK(BM_Floor_PyramidFast_7Scenes)->Apply(configure);
+BENCHMARK(BM_Floor_PyramidBlur_7Scenes)->Apply(configure);
 
 }  // namespace
 }  // namespace edgeslam

@@ -87,7 +87,7 @@ int runServer(const ServerOptions& o) {
     const double uptime_s =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
     try {
-      writeServerMetrics(o.metrics, serverMetricsJson(server, uptime_s));
+      writeServerMetrics(o.metrics, serverMetricsJson(server, uptime_s, store.stats.get()));
     } catch (const std::exception& e) {
       spdlog::warn("server metrics: {}", e.what());
     }

@@ -386,6 +386,34 @@ std::optional<std::string> SlamSessionBackend::failure() const {
   return std::nullopt;
 }
 
+BackendCosts SlamSessionBackend::costs() const {
+  MutexLock view_lock(view_mutex_);
+  BackendCosts costs;
+  if (localization_) {
+    const EdgeLocalizationStats stats = localization_->stats();
+    costs.stages_ms.emplace_back("relocalization", stats.relocalization_ms.summary());
+    return costs;
+  }
+  if (!mapping_) return costs;
+  const EdgeMapSessionStats session = mapping().stats();
+  costs.map_keyframes = session.keyframes;
+  costs.map_points = session.map_points;
+  const LocalMapperStats mapper = mapping().mapper().stats();
+  costs.stages_ms.emplace_back("keyframe_mapping", mapper.keyframe_ms.summary());
+  costs.stages_ms.emplace_back("local_ba", mapper.local_ba_ms.summary());
+  if (const LoopCloser* closer = mapping().loopCloser()) {
+    const LoopCloserStats loops = closer->stats();
+    costs.stages_ms.emplace_back("loop_detection", loops.detection_ms.summary());
+    SampleStats correction;
+    for (const LoopEvent& event : loops.events) correction.add(event.correction_ms);
+    costs.stages_ms.emplace_back("loop_correction", correction.summary());
+    SampleStats global_ba;
+    for (const double ms : loops.global_ba_ms) global_ba.add(ms);
+    costs.stages_ms.emplace_back("global_ba", global_ba.summary());
+  }
+  return costs;
+}
+
 MapSample SlamSessionBackend::mapSample(std::size_t max_points) const {
   MutexLock view_lock(view_mutex_);
   if (offload_) return offload_->mapSample(max_points);

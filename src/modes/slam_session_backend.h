@@ -42,6 +42,9 @@ class SlamSessionBackend : public EdgeSessionBackend {
   void onFullResyncRequested() override;
   std::uint64_t idFloor() const override { return id_floor_; }
   std::optional<std::string> failure() const override;
+  // Edge mode: per keyframe mapped, local BA, loop detection; per loop correction and global BA.
+  // Localise-only: per relocalisation of a lost frame against the whole map.
+  BackendCosts costs() const override;
 
   // For a viewer, from any thread: the session's map now (its global map in edge mode, the
   // offloaded SLAM's map in offload mode; empty before the first keyframe or frame) and the loops

@@ -116,6 +116,7 @@ class EdgeMapSession {
   Map& map() { return map_; }
   // The keyframes the first client holds (lock the map's update mutex while reading).
   const ClientMapWindow& clientWindow() const { return first_client_->window; }
+  const LocalMapper& mapper() const { return backend_->mapper(); }
   // nullptr without a vocabulary or with loop closing off.
   const LoopCloser* loopCloser() const { return backend_->loopCloser(); }
   // nullptr without segmentation.

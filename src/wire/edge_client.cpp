@@ -85,7 +85,7 @@ struct EdgeClient::Impl {
                           ? ""
                           : ", and does its TLS certificate match the CA and the address"));
     }
-    if (const grpc::Status status = openSession(options.connect_timeout); !status.ok()) {
+    if (const grpc::Status status = openSession(options.open_session_timeout); !status.ok()) {
       throw EdgeClientError(
           fmt::format("edge server at '{}' refused the session: {}", address, describe(status)));
     }
@@ -148,7 +148,7 @@ struct EdgeClient::Impl {
       acknowledged_while_resyncing.clear();
     }
     resync_pending.store(true);
-    const grpc::Status status = openSession(options.rpc_timeout);
+    const grpc::Status status = openSession(options.open_session_timeout);
     if (!status.ok()) {
       spdlog::warn("edge client: reopening the session failed: {}", describe(status));
       return false;

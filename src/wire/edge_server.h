@@ -8,14 +8,24 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "map/map_records.h"
+#include "util/timing_stats.h"
 #include "wire/server_security.h"
 #include "wire/slice_sink.h"
 #include "wire/wire_types.h"
 
 namespace edgeslam {
+
+// What a session's back end has spent, for the server's metrics: wall ms per unit of work, by stage
+// (per keyframe mapped, per loop detection, per global BA...), and the size of its map.
+struct BackendCosts {
+  std::uint64_t map_keyframes = 0;
+  std::uint64_t map_points = 0;
+  std::vector<std::pair<std::string, PercentileSummary>> stages_ms;
+};
 
 // One client session on the edge. Calls on one backend never overlap (the server serialises
 // them), but they run on the server's RPC threads: return quickly and do heavy work elsewhere.
@@ -42,6 +52,8 @@ class EdgeSessionBackend {
   // nullopt while it works. Any thread, any time: the server asks before each call and ends a
   // failed session (ABORTED to its client, the cause in its log and metrics).
   virtual std::optional<std::string> failure() const { return std::nullopt; }
+  // Unlike the calls above, from any thread while the session runs (the server's metrics).
+  virtual BackendCosts costs() const { return {}; }
 };
 
 class EdgeSessionFactory {
@@ -87,6 +99,7 @@ struct SessionStats {
   std::uint64_t slices_dropped = 0;  // dropped unacknowledged (queue bounds)
   std::uint64_t slices_acknowledged = 0;
   bool streaming = false;
+  BackendCosts costs;
 };
 
 // What the sessions closed so far had received and left undelivered, summed: a client that
@@ -106,6 +119,9 @@ struct ClosedSessionTotals {
   // Made but never acknowledged by the client; a clean close leaves its last slice here too
   // (applied, but acknowledgements ride on uploads and none followed).
   std::uint64_t slices_unacknowledged = 0;
+  // The sessions closed last (at most kRecentClosedSessions), oldest first, as they closed.
+  std::vector<SessionStats> recent;
+  static constexpr std::size_t kRecentClosedSessions = 16;
 };
 
 class EdgeServer {

@@ -181,6 +181,7 @@ void SessionRegistry::account(const ServerSession& s, CloseReason reason) {
   const std::uint64_t acknowledged = s.slices.acknowledged();
   const std::uint64_t unacknowledged = pushed - std::min(pushed, acknowledged);
   const std::uint64_t dropped = s.slices.droppedUnacknowledged();
+  SessionStats last = statsOf(s);
   {
     MutexLock lock(totals_mutex_);
     ClosedSessionTotals& t = closed_totals_;
@@ -208,6 +209,9 @@ void SessionRegistry::account(const ServerSession& s, CloseReason reason) {
     t.slices_pushed += pushed;
     t.slices_dropped += dropped;
     t.slices_unacknowledged += unacknowledged;
+    if (t.recent.size() == ClosedSessionTotals::kRecentClosedSessions)
+      t.recent.erase(t.recent.begin());
+    t.recent.push_back(std::move(last));
   }
   // The last slice of a clean end is applied but never acknowledged (acknowledgements ride on
   // uploads, and none follows it): not worth a warning.
@@ -231,6 +235,27 @@ ClosedSessionTotals SessionRegistry::closedTotals() const {
   return closed_totals_;
 }
 
+SessionStats SessionRegistry::statsOf(const ServerSession& s) {
+  SessionStats stats;
+  stats.session_id = s.config.session_id;
+  stats.id_origin = s.config.id_origin;
+  stats.client_name = s.config.client_name;
+  stats.uplink_bytes = s.uplink_bytes.load();
+  stats.downlink_bytes = s.downlink_bytes.load();
+  stats.keyframes = s.keyframes.load();
+  stats.duplicate_uploads = s.duplicate_uploads.load();
+  stats.missing_uploads = s.missing_uploads.load();
+  stats.frames = s.frames.load();
+  stats.slices_pushed = s.slices.lastPushed();
+  stats.slices_sent = s.slices_sent.load();
+  stats.slices_dropped = s.slices.droppedUnacknowledged();
+  stats.slices_acknowledged = s.slices.acknowledged();
+  stats.streaming = s.active_streams.load() > 0;
+  // Set once when the session opens, before it is shared; absent while it is being opened.
+  if (s.backend) stats.costs = s.backend->costs();
+  return stats;
+}
+
 std::vector<SessionStats> SessionRegistry::stats() const {
   std::vector<std::shared_ptr<ServerSession>> sessions;
   {
@@ -238,24 +263,8 @@ std::vector<SessionStats> SessionRegistry::stats() const {
     for (const auto& entry : sessions_) sessions.push_back(entry.second);
   }
   std::vector<SessionStats> out;
-  for (const auto& s : sessions) {
-    SessionStats stats;
-    stats.session_id = s->config.session_id;
-    stats.id_origin = s->config.id_origin;
-    stats.client_name = s->config.client_name;
-    stats.uplink_bytes = s->uplink_bytes.load();
-    stats.downlink_bytes = s->downlink_bytes.load();
-    stats.keyframes = s->keyframes.load();
-    stats.duplicate_uploads = s->duplicate_uploads.load();
-    stats.missing_uploads = s->missing_uploads.load();
-    stats.frames = s->frames.load();
-    stats.slices_pushed = s->slices.lastPushed();
-    stats.slices_sent = s->slices_sent.load();
-    stats.slices_dropped = s->slices.droppedUnacknowledged();
-    stats.slices_acknowledged = s->slices.acknowledged();
-    stats.streaming = s->active_streams.load() > 0;
-    out.push_back(std::move(stats));
-  }
+  out.reserve(sessions.size());
+  for (const auto& s : sessions) out.push_back(statsOf(*s));
   return out;
 }
 

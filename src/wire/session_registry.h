@@ -98,6 +98,7 @@ class SessionRegistry {
   bool close(std::uint64_t session_id, CloseReason reason);
   // Adds a closed session to the totals and logs what it leaves undelivered.
   void account(const ServerSession& session, CloseReason reason);
+  static SessionStats statsOf(const ServerSession& session);
   std::uint8_t reserveOriginLocked(std::uint8_t preferred) REQUIRES(mutex_);
   // The session to close for a new one when full, or 0.
   std::uint64_t reclaimableLocked() const REQUIRES(mutex_);

@@ -189,6 +189,17 @@ TEST_F(ServerFaults, ClientKilledMidUploadIsClosedAndCountedWhileOthersRunOn) {
   EXPECT_EQ(closed["by_client"], 1) << m.dump(2);  // the healthy client
   EXPECT_GT(closed["keyframes"].get<int>(), 3) << m.dump(2);
   EXPECT_EQ(m["sessions_open"], 0) << m.dump(2);
+  // Each closed session, with what its back end spent: both clients' keyframes were mapped (and
+  // bundle-adjusted) on the edge, one timing each.
+  ASSERT_EQ(closed["recent"].size(), 2u) << m.dump(2);
+  for (const auto& session : closed["recent"]) {
+    const auto& costs = session["backend_ms"];
+    EXPECT_GT(session["map_keyframes"].get<int>(), 2) << session.dump(2);
+    EXPECT_GT(costs["keyframe_mapping"]["count"].get<int>(), 2) << session.dump(2);
+    EXPECT_GT(costs["keyframe_mapping"]["median"].get<double>(), 0.0) << session.dump(2);
+    EXPECT_GT(costs["local_ba"]["count"].get<int>(), 0) << session.dump(2);
+    EXPECT_FALSE(costs.contains("loop_detection")) << "no vocabulary, no loop closing";
+  }
   EXPECT_NE(server_->log().find("closed idle (its client went silent)"), std::string::npos)
       << server_->log();
   expectServerStopsCleanly();
