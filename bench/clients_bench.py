@@ -50,7 +50,7 @@ def proc_sample(pid):
 def client_command(args, port, sensor, out_dir, name):
     command = [os.path.join(args.build, "edgeslam"), "client", "--server", f"127.0.0.1:{port}",
                "--dataset", args.dataset, "--sensor", sensor, "--realtime",
-               "--max-frames", str(args.frames), "--out", out_dir]
+               "--max-frames", str(args.frames), "--out", out_dir] + args.client_args.split()
     if args.localize_only:
         # Every client localises in the one map stored before the runs (stored_map below).
         return command + ["--localize-only", "--map", stored_map_name(sensor),
@@ -258,6 +258,8 @@ def main():
     parser.add_argument("--frames", type=int, default=1000)
     parser.add_argument("--sample-s", type=float, default=1.0)
     parser.add_argument("--no-docs", action="store_true")
+    parser.add_argument("--client-args", default="",
+                        help="more arguments for every client (e.g. '--compute-adapt off')")
     parser.add_argument("--localize-only", action="store_true",
                         help="clients localise (--localize-only) in a map stored first by an "
                              "edge run over the whole dataset, instead of mapping")

@@ -33,9 +33,9 @@ void ComputeBudgetOptions::validate() const {
   }
   if (window == 0) throw std::invalid_argument("compute budget: the window must hold frames");
   if (!(under_budget > 0.0 && under_budget < over_budget && std::isfinite(over_budget))) {
-    throw std::invalid_argument(fmt::format(
-        "compute budget: budgets must satisfy 0 < under ({}) < over ({})", under_budget,
-        over_budget));
+    throw std::invalid_argument(
+        fmt::format("compute budget: budgets must satisfy 0 < under ({}) < over ({})", under_budget,
+                    over_budget));
   }
   if (!(skipped_share > 0.0) || up_windows < 1) {
     throw std::invalid_argument("compute budget: skipped_share and up_windows must be positive");

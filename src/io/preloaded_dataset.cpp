@@ -13,7 +13,9 @@
 namespace edgeslam {
 namespace {
 
-std::size_t matBytes(const cv::Mat& mat) { return mat.empty() ? 0 : mat.total() * mat.elemSize(); }
+std::size_t matBytes(const cv::Mat& mat) {
+  return mat.empty() ? 0 : mat.total() * mat.elemSize();
+}
 
 // MemAvailable of /proc/meminfo in bytes; nullopt where it cannot be read.
 std::optional<std::size_t> availableMemoryBytes() {

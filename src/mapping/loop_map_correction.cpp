@@ -1,6 +1,14 @@
 #include "mapping/loop_map_correction.h"
 
 namespace edgeslam {
+namespace {
+
+bool isIdentity(const Sim3d& s) {
+  return s.scale() == 1.0 && s.translation().isZero(0.0) &&
+         s.rotation().coeffs() == Eigen::Quaterniond::Identity().coeffs();
+}
+
+}  // namespace
 
 Sim3d worldCorrection(const KeyFrameCorrection& correction) {
   return correction.after.inverse() * correction.before;
@@ -34,7 +42,11 @@ MapCorrectionStats applyMapCorrection(Map& map, const MapCorrection& correction)
       new_poses.emplace_back(kf, it->second.after.toSE3());
       ++stats.keyframes_moved;
     } else {
-      new_poses.emplace_back(kf, (Sim3d(kf->pose()) * worldFor(kf).inverse()).toSE3());
+      const Sim3d world = worldFor(kf);
+      // No corrected ancestor (a part of the map the correction did not touch): left as it is,
+      // not rewritten (each rewrite is a pose change the store and the slices pass on).
+      if (isIdentity(world)) continue;
+      new_poses.emplace_back(kf, (Sim3d(kf->pose()) * world.inverse()).toSE3());
       ++stats.keyframes_propagated;
     }
   }
