@@ -207,6 +207,21 @@ def measure(args, store, name):
     return row
 
 
+def median_row(runs):
+    """Per column, the median of the runs (columns a run lacks are left out); `spread` keeps
+    min-max of the main columns."""
+    row = {}
+    for key in runs[0]:
+        values = [r[key] for r in runs if r.get(key) is not None]
+        row[key] = statistics.median(values) if values else None
+    row["runs"] = len(runs)
+    row["spread"] = {key: (min(r[key] for r in runs if r.get(key) is not None),
+                           max(r[key] for r in runs if r.get(key) is not None))
+                     for key in ("load_ms", "keyframe_ms", "reloc_ms", "loop_correction_ms")
+                     if any(r.get(key) is not None for r in runs)}
+    return row
+
+
 def growth(sizes, values):
     """Exponent of a least-squares fit values ~ size^k and its name."""
     pts = [(math.log(s), math.log(v)) for s, v in zip(sizes, values) if v and v > 0]
@@ -252,14 +267,22 @@ def table(rows, args, source_keyframes, source_ate):
         f"(core 0) at a time at the camera's rate: an RGB-D edge client mapping frames "
         f"{args.mapping_frames} into the map, then a localise-only client on "
         f"{len(args.localize_frames.split(','))} stretches of 20 frames across the sequence (a "
-        "relocalisation by the edge against the whole map at each jump). Edge costs are the server's (`server --metrics`, per session: "
-        "`backend_ms`). Growth: the exponent k of a log-log fit (cost ~ keyframes^k).",
+        "relocalisation by the edge against the whole map at each jump). Edge costs are the "
+        "server's (`server --metrics`, per session: "
+        f"`backend_ms`). Each size run {args.runs} times on a fresh copy of its map: medians of the "
+        "runs' figures (each itself a median over the session's keyframes or relocalisations). "
+        "Growth: the exponent k of a log-log fit (cost ~ keyframes^k).",
         "",
         "| " + " | ".join(h for _, h, _ in COLUMNS) + " |",
         "|" + "---|" * len(COLUMNS),
     ]
     for row in rows:
         lines.append("| " + " | ".join(cell(row, k, d) for k, _, d in COLUMNS) + " |")
+    spreads = []
+    for row in rows:
+        parts = [f"{k} {lo:.0f}-{hi:.0f}" for k, (lo, hi) in row.get("spread", {}).items()]
+        spreads.append(f"{row['keyframes']:.0f}: " + ", ".join(parts))
+    lines += ["", "Spread of the runs (min-max, ms): " + "; ".join(spreads) + "."]
     fits = []
     for key, header, digits in COLUMNS[3:]:
         k, name = growth(sizes, [r.get(key) for r in rows])
@@ -328,6 +351,8 @@ def main():
                         default=",".join(f"{a}-{a + 19}" for a in range(40, 1000, 80)))
     parser.add_argument("--settle-s", type=float, default=5.0,
                         help="seconds the server gets after a client, for loops and global BA")
+    parser.add_argument("--runs", type=int, default=3,
+                        help="runs per size (a fresh copy of the map each): medians in the table")
     parser.add_argument("--keep", default=None, help="keep the store and outputs in this folder")
     parser.add_argument("--no-docs", action="store_true")
     args = parser.parse_args()
@@ -351,7 +376,11 @@ def main():
         name = f"scale-{copies}"
         log(f"[{time.monotonic() - started:.0f} s] {copies} copies (~{copies * source_keyframes} "
             "keyframes)")
-        rows.append(measure(args, make_map(args, store, name, copies), name))
+        runs = []
+        for run in range(args.runs):
+            log(f"  run {run + 1}/{args.runs}")
+            runs.append(measure(args, make_map(args, store, name, copies), name))
+        rows.append(median_row(runs))
     block = table(rows, args, source_keyframes, source_ate)
     print(block)
     if not args.no_docs:
