@@ -23,6 +23,7 @@ import sys
 import tempfile
 
 from host_check import host_check, host_line
+from docs_block import replace_block
 from link_experiments import free_port, stop_process, wait_for_port
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -48,8 +49,9 @@ def micro_benchmarks(args, exe, pattern):
         if b.get("aggregate_name") != "median":
             continue
         ms = b["real_time"] * {"ms": 1.0, "us": 1e-3, "ns": 1e-6}[b["time_unit"]]
-        result[re.sub(r"/(repeats:\d+|real_time)", "", b["run_name"])] = {"ms": ms, **{k: v for k, v in b.items()
-                                               if k in ("keypoints", "corners", "matches")}}
+        name = re.sub(r"/(repeats:\d+|real_time)", "", b["run_name"])
+        counters = {k: v for k, v in b.items() if k in ("keypoints", "corners", "matches")}
+        result[name] = {"ms": ms, **counters}
     return result
 
 
@@ -152,17 +154,8 @@ def table(args, sensors, micro, host):
 
 
 def update_docs(block):
-    with open(DOCS) as f:
-        text = f.read()
-    if BEGIN in text and END in text:
-        head, rest = text.split(BEGIN, 1)
-        _, tail = rest.split(END, 1)
-        text = head + BEGIN + "\n" + block + "\n" + END + tail
-    else:
-        text += ("\n## The client's stages against their floors (`bench/client_stages_bench.py`)"
-                 "\n\n" + BEGIN + "\n" + block + "\n" + END + "\n")
-    with open(DOCS, "w") as f:
-        f.write(text)
+    replace_block(DOCS, BEGIN, END, block,
+                  "The client's stages against their floors (`bench/client_stages_bench.py`)")
 
 
 def main():

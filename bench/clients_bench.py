@@ -23,6 +23,7 @@ import tempfile
 import time
 
 from host_check import host_check, host_line
+from docs_block import replace_block
 from link_experiments import (PALETTE, Panel, free_port, legend, nice_ticks, fmt_tick,
                               stop_process, svg_document, wait_for_port, write)
 
@@ -232,18 +233,10 @@ def time_chart(path, title, results, column, y_label):
 
 
 def update_docs(block, localize_only):
-    with open(DOCS) as f:
-        text = f.read()
     begin, end = (LOCALIZE_BEGIN, LOCALIZE_END) if localize_only else (BEGIN, END)
     title = ("Localise-only clients on one server (`bench/clients_bench.py --localize-only`)"
              if localize_only else "Many clients on one server (`bench/clients_bench.py`)")
-    section = f"{begin}\n{block}\n{end}"
-    if begin in text:
-        text = text[:text.index(begin)] + section + text[text.index(end) + len(end):]
-    else:
-        text += f"\n## {title}\n\n{section}\n"
-    with open(DOCS, "w") as f:
-        f.write(text)
+    replace_block(DOCS, begin, end, block, title)
 
 
 def main():

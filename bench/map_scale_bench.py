@@ -32,6 +32,7 @@ import sys
 import tempfile
 import time
 
+from docs_block import replace_block
 from link_experiments import (PALETTE, Panel, free_port, legend, stop_process, svg_document,
                               wait_for_port, write)
 
@@ -324,17 +325,8 @@ def figure(rows):
 
 
 def update_docs(block):
-    with open(DOCS) as f:
-        text = f.read()
-    if BEGIN in text and END in text:
-        head, rest = text.split(BEGIN, 1)
-        _, tail = rest.split(END, 1)
-        text = head + BEGIN + "\n" + block + "\n" + END + tail
-    else:
-        text += ("\n## Cost against map size (`bench/map_scale_bench.py`)\n\n" + BEGIN + "\n" +
-                 block + "\n" + END + "\n")
-    with open(DOCS, "w") as f:
-        f.write(text)
+    replace_block(DOCS, BEGIN, END, block,
+                  "Cost against map size (`bench/map_scale_bench.py`)")
 
 
 def main():

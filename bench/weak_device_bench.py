@@ -29,6 +29,7 @@ import tempfile
 import time
 
 from host_check import host_check, host_line
+from docs_block import replace_block
 from link_experiments import (PALETTE, Panel, free_port, legend, stop_process, svg_document,
                               wait_for_port, write)
 
@@ -261,17 +262,8 @@ def figure(results, args):
 
 
 def update_docs(block):
-    with open(DOCS) as f:
-        text = f.read()
-    if BEGIN in text and END in text:
-        head, rest = text.split(BEGIN, 1)
-        _, tail = rest.split(END, 1)
-        text = head + BEGIN + "\n" + block + "\n" + END + tail
-    else:
-        text += ("\n## The weak device: the client under a CPU quota "
-                 "(`bench/weak_device_bench.py`)\n\n" + BEGIN + "\n" + block + "\n" + END + "\n")
-    with open(DOCS, "w") as f:
-        f.write(text)
+    replace_block(DOCS, BEGIN, END, block,
+                  "The weak device: the client under a CPU quota (`bench/weak_device_bench.py`)")
 
 
 def main():

@@ -265,7 +265,7 @@ std::optional<ComputeBudgetOptions> computeBudgetFor(const RunOptions& options,
                                                      const PinholeCamera& camera) {
   if (!options.realtime || !options.compute_adapt || mode == "offload") return std::nullopt;
   const double fps = camera.intrinsics().fps > 0.0 ? camera.intrinsics().fps : 30.0;
-  if ((options.features || options.levels) && options.realtime) {
+  if (options.features || options.levels) {
     spdlog::info(
         "--compute-adapt on: --features and --levels are where the client starts; it lowers them "
         "when frames do not fit the camera's period (--compute-adapt off keeps them)");

@@ -42,7 +42,7 @@ nlohmann::json sessionJson(const SessionStats& s) {
 nlohmann::json serverMetricsJson(const EdgeServer& server, double uptime_s,
                                  const MapStoreWriteStats* store) {
   nlohmann::json open = nlohmann::json::array();
-  for (const SessionStats& s : server.sessions()) open.push_back(sessionJson(s));
+  for (const SessionStats& s : server.sessions(true)) open.push_back(sessionJson(s));
   const ClosedSessionTotals c = server.closedSessions();
   nlohmann::json metrics = {{"uptime_s", uptime_s},
                             {"rss_bytes", residentBytes()},

@@ -124,8 +124,8 @@ void EdgeServer::shutdown() {
   impl_->shutdown();
 }
 
-std::vector<SessionStats> EdgeServer::sessions() const {
-  return impl_->registry.stats();
+std::vector<SessionStats> EdgeServer::sessions(bool costs) const {
+  return impl_->registry.stats(costs);
 }
 
 std::size_t EdgeServer::sessionCount() const {

@@ -142,7 +142,9 @@ class EdgeServer {
   // still connected. Idempotent.
   void shutdown();
 
-  std::vector<SessionStats> sessions() const;
+  // With `costs`, each session's back end is asked what it spent (SessionStats::costs): summaries
+  // of every timing so far, worth it for the metrics file, not for every view.
+  std::vector<SessionStats> sessions(bool costs = false) const;
   std::size_t sessionCount() const;
   // Sessions closed because their client went silent.
   std::uint64_t idleSessionsClosed() const;

@@ -181,7 +181,7 @@ void SessionRegistry::account(const ServerSession& s, CloseReason reason) {
   const std::uint64_t acknowledged = s.slices.acknowledged();
   const std::uint64_t unacknowledged = pushed - std::min(pushed, acknowledged);
   const std::uint64_t dropped = s.slices.droppedUnacknowledged();
-  SessionStats last = statsOf(s);
+  SessionStats last = statsOf(s, true);
   {
     MutexLock lock(totals_mutex_);
     ClosedSessionTotals& t = closed_totals_;
@@ -235,7 +235,7 @@ ClosedSessionTotals SessionRegistry::closedTotals() const {
   return closed_totals_;
 }
 
-SessionStats SessionRegistry::statsOf(const ServerSession& s) {
+SessionStats SessionRegistry::statsOf(const ServerSession& s, bool costs) {
   SessionStats stats;
   stats.session_id = s.config.session_id;
   stats.id_origin = s.config.id_origin;
@@ -252,11 +252,11 @@ SessionStats SessionRegistry::statsOf(const ServerSession& s) {
   stats.slices_acknowledged = s.slices.acknowledged();
   stats.streaming = s.active_streams.load() > 0;
   // Set once when the session opens, before it is shared; absent while it is being opened.
-  if (s.backend) stats.costs = s.backend->costs();
+  if (costs && s.backend) stats.costs = s.backend->costs();
   return stats;
 }
 
-std::vector<SessionStats> SessionRegistry::stats() const {
+std::vector<SessionStats> SessionRegistry::stats(bool costs) const {
   std::vector<std::shared_ptr<ServerSession>> sessions;
   {
     MutexLock lock(mutex_);
@@ -264,7 +264,7 @@ std::vector<SessionStats> SessionRegistry::stats() const {
   }
   std::vector<SessionStats> out;
   out.reserve(sessions.size());
-  for (const auto& s : sessions) out.push_back(statsOf(*s));
+  for (const auto& s : sessions) out.push_back(statsOf(*s, costs));
   return out;
 }
 

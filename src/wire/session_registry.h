@@ -87,7 +87,7 @@ class SessionRegistry {
   std::size_t closeIdle(std::chrono::milliseconds idle_timeout);
   void closeAll();
 
-  std::vector<SessionStats> stats() const;
+  std::vector<SessionStats> stats(bool costs = false) const;
   std::size_t size() const;
   std::uint64_t idleClosed() const { return idle_closed_.load(); }
   std::uint64_t reclaimed() const { return reclaimed_.load(); }
@@ -98,7 +98,7 @@ class SessionRegistry {
   bool close(std::uint64_t session_id, CloseReason reason);
   // Adds a closed session to the totals and logs what it leaves undelivered.
   void account(const ServerSession& session, CloseReason reason);
-  static SessionStats statsOf(const ServerSession& session);
+  static SessionStats statsOf(const ServerSession& session, bool costs);
   std::uint8_t reserveOriginLocked(std::uint8_t preferred) REQUIRES(mutex_);
   // The session to close for a new one when full, or 0.
   std::uint64_t reclaimableLocked() const REQUIRES(mutex_);
