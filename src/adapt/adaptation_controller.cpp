@@ -23,11 +23,13 @@ AdaptationController::AdaptationController(AdaptationOptions options)
       !(options_.min_margin_ms >= 0.0)) {
     throw std::invalid_argument("message_bytes and margins must be >= 0");
   }
-  if (options_.first_estimate_latency_samples >
-      std::max<std::size_t>(1, options_.estimator_window)) {
-    throw std::invalid_argument(
-        fmt::format("first_estimate_latency_samples {} exceeds the estimator window {}",
-                    options_.first_estimate_latency_samples, options_.estimator_window));
+  const std::size_t window = std::max<std::size_t>(1, options_.estimator_window);
+  if (options_.first_estimate_latency_samples > window ||
+      options_.first_estimate_bandwidth_samples > window) {
+    throw std::invalid_argument(fmt::format(
+        "first estimate on {} latency and {} bandwidth samples: more than the estimator window {}",
+        options_.first_estimate_latency_samples, options_.first_estimate_bandwidth_samples,
+        options_.estimator_window));
   }
 }
 
@@ -62,7 +64,9 @@ bool AdaptationController::observe(double n_ms) {
 bool AdaptationController::reevaluateLocked() {
   const auto n_ms = estimator_.networkTimeMs(options_.message_bytes);
   if (!n_ms) return false;
-  if (!has_estimate_ && estimator_.latencySampleCount() < options_.first_estimate_latency_samples) {
+  if (!has_estimate_ &&
+      (estimator_.latencySampleCount() < options_.first_estimate_latency_samples ||
+       estimator_.bandwidthSampleCount() < options_.first_estimate_bandwidth_samples)) {
     last_n_ms_ = *n_ms;
     return false;
   }

@@ -2,8 +2,9 @@
 // Picks the Table I configuration from the network condition N = L + M/B, with hysteresis so that
 // noise around a row boundary does not make the keyframe rules flap:
 //  - the first estimate selects its row directly, once it rests on `first_estimate_latency_samples`
-//    latency probes (a median of one sample would let a slow first probe, which also opens the
-//    connection, pick the row, and the hysteresis then keeps it);
+//    latency probes and `first_estimate_bandwidth_samples` sized probes (a median of one sample
+//    would let a slow first probe, which also opens the connection or meets the edge busy with
+//    the new map's first keyframes, pick the row, and the hysteresis then keeps it);
 //  - afterwards the row changes only when N leaves the current row's interval by a margin
 //    (max(min_margin_ms, margin_fraction * boundary)) for `confirm_count` consecutive estimates;
 //    it then moves to the row that holds the latest N.
@@ -26,7 +27,8 @@ struct AdaptationOptions {
   double min_margin_ms = 1.0;
   int confirm_count = 3;
   std::size_t estimator_window = 5;
-  std::size_t first_estimate_latency_samples = 3;   // at most estimator_window
+  std::size_t first_estimate_latency_samples = 3;    // at most estimator_window
+  std::size_t first_estimate_bandwidth_samples = 2;  // at most estimator_window
   std::size_t initial_row = kDefaultAdaptationRow;  // in effect until the first estimate
 };
 

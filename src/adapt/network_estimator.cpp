@@ -12,7 +12,7 @@ namespace edgeslam {
 namespace {
 
 // A transfer time shorter than this is below the clock's and the scheduler's resolution: the
-// probe was too small for the link and says nothing about B.
+// probe was too small to show the link's B, only that B is at least bytes / kMinTransferMs.
 constexpr double kMinTransferMs = 0.05;
 
 }  // namespace
@@ -40,8 +40,7 @@ bool NetworkEstimator::addBandwidthProbe(std::size_t bytes, double elapsed_ms) {
   }
   const auto latency = latencyMs();
   if (!latency || bytes == 0) return false;
-  const double transfer_ms = elapsed_ms - *latency;
-  if (transfer_ms < kMinTransferMs) return false;
+  const double transfer_ms = std::max(kMinTransferMs, elapsed_ms - *latency);
   push(bandwidth_samples_, static_cast<double>(bytes) * 8.0 / (transfer_ms * 1e3), window_);
   return true;
 }

@@ -6,6 +6,11 @@
 //       B = bytes / (elapsed - L), with L the current latency estimate.
 // Both are the median of the last `window` samples: one outlier (a retransmission, a scheduler
 // hiccup) cannot move a median of 5, and a lasting change shows after 3 samples.
+// A sized probe that came back no later than the latency estimate says the link moved its bytes
+// faster than the probe can resolve: it counts as a sample at that resolution (the fastest B it
+// could have shown), not as no sample. Dropping such probes kept only the ones a busy edge or a
+// starved client had delayed, and on a fast link their median alone made B look like a few
+// Mbit/s (a loopback link at 6.6 Mbit/s, Table I's last row for a whole KITTI run).
 #include <cstddef>
 #include <deque>
 #include <optional>
@@ -22,12 +27,13 @@ class NetworkEstimator {
   // Throws std::invalid_argument for a negative or non-finite RTT.
   void addLatencyProbe(double rtt_ms);
   // `bytes` sent and acknowledged in `elapsed_ms`. Ignored (returns false) until a latency
-  // estimate exists or when elapsed_ms does not exceed it by a measurable amount.
+  // estimate exists, or for an empty probe.
   bool addBandwidthProbe(std::size_t bytes, double elapsed_ms);
 
   std::optional<double> latencyMs() const;
   std::size_t latencySampleCount() const { return latency_samples_.size(); }
   std::optional<double> bandwidthMbps() const;
+  std::size_t bandwidthSampleCount() const { return bandwidth_samples_.size(); }
   // N for a message of `message_bytes`, once both estimates exist.
   std::optional<double> networkTimeMs(double message_bytes) const;
 

@@ -1,6 +1,7 @@
 #pragma once
 // When to probe the link, and what probing costs. Every `small_interval_s` a small echo probe
-// (latency); every `sized_interval_s` a sized probe (bandwidth) big enough that its transfer time
+// (latency); every `sized_interval_s` a sized probe (bandwidth; the second one already a small
+// interval after the first, as the first estimate waits for two) big enough that its transfer time
 // stands out of the RTT noise: about `sized_target_ms` at the current bandwidth estimate, clamped
 // to [sized_min_bytes, sized_max_bytes]. Costs are in docs/links.md ("Probe costs").
 #include <cstddef>
@@ -30,6 +31,8 @@ class ProbeScheduler {
 
   // The probe due at `now_s` (any monotonic origin), marked as sent; kNone when nothing is due.
   // The first call returns kSmall, the next one kSized: a bandwidth probe needs a latency first.
+  // The second sized probe is due `small_interval_s` after the first, later ones every
+  // `sized_interval_s`.
   ProbeKind next(double now_s);
   // Payload of the next sized probe for the current bandwidth estimate (Mbit/s).
   std::size_t sizedProbeBytes(std::optional<double> bandwidth_mbps) const;
@@ -42,6 +45,7 @@ class ProbeScheduler {
   ProbeSchedule schedule_;
   std::optional<double> next_small_s_;
   std::optional<double> next_sized_s_;
+  int sized_sent_ = 0;
 };
 
 }  // namespace edgeslam

@@ -185,6 +185,8 @@ AdaptationLoop::ProbeOutcome AdaptationLoop::timedProbe(std::size_t payload_byte
                   elapsed_ms);
     return {std::max(elapsed_ms, timeout_ms), false, false};
   }
+  spdlog::debug("adaptation: probe of {} B answered in {:.2f} ms", payload_bytes,
+                result->round_trip_ms);
   probe_uplink_bytes_ += result->sent_bytes;
   probe_downlink_bytes_ += result->received_bytes;
   return {result->round_trip_ms, true};

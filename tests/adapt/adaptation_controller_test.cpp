@@ -41,9 +41,11 @@ TEST(AdaptationController, PicksTheRowOfNFromProbes) {
     EXPECT_EQ(controller.row(), kDefaultAdaptationRow);  // one latency sample is not enough
     controller.onLatencyProbe(c.rtt_ms, 300);
     controller.onLatencyProbe(c.rtt_ms, 300);
+    EXPECT_EQ(controller.row(), kDefaultAdaptationRow);  // nor one bandwidth sample
+    controller.onBandwidthProbe(bytes, elapsed, bytes + 400);
     EXPECT_EQ(controller.row(), c.expected_row) << "rtt " << c.rtt_ms << " B " << c.mbps;
     EXPECT_EQ(controller.config(), adaptationTable()[c.expected_row].config);
-    EXPECT_EQ(controller.probeBytes(), 3 * 300u + bytes + 400u);
+    EXPECT_EQ(controller.probeBytes(), 3 * 300u + 2 * (bytes + 400u));
   }
 }
 
@@ -107,8 +109,24 @@ TEST(AdaptationController, ASlowFirstProbeDoesNotPickTheRow) {
   controller.onLatencyProbe(44.0, 100);
   EXPECT_EQ(controller.switches(), 0u);
   controller.onLatencyProbe(44.5, 100);
+  EXPECT_EQ(controller.switches(), 0u);  // one bandwidth sample
+  controller.onBandwidthProbe(bytes, 44.0 + bytes * 8.0 / (bandwidth_mbps * 1e3), bytes);
   EXPECT_EQ(controller.row(), 3u) << "N = " << controller.lastNetworkTimeMs().value_or(-1.0);
   EXPECT_EQ(controller.switches(), 1u);
+}
+
+TEST(AdaptationController, ASlowFirstSizedProbeDoesNotPickTheRow) {
+  // Loopback (1 ms) to an edge busy with a new map's first keyframes: the first 4 KiB probe waits
+  // 5 ms for the edge's CPU (B 8 Mbit/s, N 58 ms: configuration 5 on its own); the second one is
+  // on time.
+  AdaptationOptions options;
+  options.message_bytes = 57000.0;
+  AdaptationController controller(options);
+  for (int i = 0; i < 3; ++i) controller.onLatencyProbe(1.0, 100);
+  controller.onBandwidthProbe(4096, 5.0, 4500);
+  EXPECT_EQ(controller.switches(), 0u);
+  controller.onBandwidthProbe(4096, 1.0, 4500);
+  EXPECT_EQ(controller.row(), 0u) << "N = " << controller.lastNetworkTimeMs().value_or(-1.0);
 }
 
 TEST(AdaptationController, CountsFramesPerConfiguration) {
@@ -132,6 +150,9 @@ TEST(AdaptationController, RejectsBadOptions) {
   EXPECT_THROW(AdaptationController{options}, std::invalid_argument);
   options = {};
   options.first_estimate_latency_samples = options.estimator_window + 1;
+  EXPECT_THROW(AdaptationController{options}, std::invalid_argument);
+  options = {};
+  options.first_estimate_bandwidth_samples = options.estimator_window + 1;
   EXPECT_THROW(AdaptationController{options}, std::invalid_argument);
   AdaptationController controller;
   EXPECT_THROW(controller.setMessageBytes(-1.0), std::invalid_argument);

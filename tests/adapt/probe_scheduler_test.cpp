@@ -30,6 +30,20 @@ TEST(ProbeScheduler, SmallEverySecondSizedEveryFiveSeconds) {
   EXPECT_EQ(sized, 12);
 }
 
+TEST(ProbeScheduler, SecondSizedProbeOneSmallIntervalAfterTheFirst) {
+  ProbeScheduler scheduler;
+  EXPECT_EQ(scheduler.next(0.0), ProbeKind::kSmall);
+  EXPECT_EQ(scheduler.next(0.0), ProbeKind::kSized);
+  EXPECT_EQ(scheduler.next(1.0), ProbeKind::kSmall);
+  EXPECT_EQ(scheduler.next(1.0), ProbeKind::kSized);
+  EXPECT_EQ(scheduler.next(2.0), ProbeKind::kSmall);
+  EXPECT_EQ(scheduler.next(2.0), ProbeKind::kNone);
+  EXPECT_EQ(scheduler.next(5.9), ProbeKind::kSmall);  // sized due at 6 (1 + 5)
+  EXPECT_EQ(scheduler.next(5.9), ProbeKind::kNone);
+  EXPECT_EQ(scheduler.next(6.0), ProbeKind::kSized);
+  EXPECT_EQ(scheduler.next(6.0), ProbeKind::kNone);
+}
+
 TEST(ProbeScheduler, NoBurstAfterAPause) {
   ProbeScheduler scheduler;
   scheduler.next(0.0);
