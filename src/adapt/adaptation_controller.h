@@ -29,7 +29,7 @@ struct AdaptationOptions {
   std::size_t estimator_window = 5;
   std::size_t first_estimate_latency_samples = 3;    // at most estimator_window
   std::size_t first_estimate_bandwidth_samples = 2;  // at most estimator_window
-  std::size_t initial_row = kDefaultAdaptationRow;  // in effect until the first estimate
+  std::size_t initial_row = kDefaultAdaptationRow;   // in effect until the first estimate
 };
 
 class AdaptationController {

@@ -38,9 +38,9 @@ ProbeKind ProbeScheduler::next(double now_s) {
     return ProbeKind::kSmall;
   }
   if (sized_due) {
-    const double interval =
-        sized_sent_++ == 0 ? std::min(schedule_.small_interval_s, schedule_.sized_interval_s)
-                           : schedule_.sized_interval_s;
+    const double interval = sized_sent_++ == 0
+                                ? std::min(schedule_.small_interval_s, schedule_.sized_interval_s)
+                                : schedule_.sized_interval_s;
     double next = *next_sized_s_ + interval;
     if (next <= now_s) next = now_s + schedule_.sized_interval_s;
     next_sized_s_ = next;
