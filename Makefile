@@ -15,7 +15,7 @@ export EDGESLAM_SHARED
 export CCACHE_BASEDIR ?= $(CURDIR)
 
 .PHONY: all deps configure build vocab test test-release test-sanitize test-tsan test-host-timing demo bench format format-check clean
-.PHONY: fuzz sanitize-build bench-scale
+.PHONY: fuzz sanitize-build bench-scale bench-pacing
 
 all: build
 
@@ -105,6 +105,12 @@ bench-scale: vocab
 	@python3 bench/weak_device_bench.py --build $(BUILD_DIR) --shared $(EDGESLAM_SHARED)
 	@python3 bench/map_scale_bench.py --build $(BUILD_DIR) --shared $(EDGESLAM_SHARED)
 	@python3 bench/clients_bench.py --build $(BUILD_DIR) --shared $(EDGESLAM_SHARED)
+
+# Accuracy against pacing (issue 24; about 1 h on this 2-core machine, best on a quiet one): KITTI 03
+# and 07, 7-Scenes mono and RGB-D, local and edge, --fast and --realtime, 5 runs a cell, with the
+# runs worse than 1.5x their cell's median named. Table into docs/benchmarks.md.
+bench-pacing: vocab
+	@python3 bench/pacing_bench.py --build $(BUILD_DIR) --shared $(EDGESLAM_SHARED) --rows kitti03,kitti07,mono,rgbd
 
 format:
 	@git ls-files '*.cpp' '*.h' | xargs clang-format -i

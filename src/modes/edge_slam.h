@@ -52,6 +52,8 @@ class EdgeSlam : public TrackingSlam {
   void offerMask(const MaskRecord& mask);
   void onFullResync(const std::vector<KeyFrameId>& edge_lacks);
   void afterFrame() override;
+  void afterTracking(const TrackResult& result, std::size_t frame_index,
+                     const cv::Mat& image) override;
   // --fast: until the edge has answered every keyframe upload (at most kMaxEdgeWaitS).
   void waitForEdge();
   static constexpr double kMaxEdgeWaitS = 10.0;
