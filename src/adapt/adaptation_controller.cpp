@@ -41,10 +41,10 @@ bool AdaptationController::onLatencyProbe(double rtt_ms, std::size_t wire_bytes)
 }
 
 bool AdaptationController::onBandwidthProbe(std::size_t payload_bytes, double elapsed_ms,
-                                            std::size_t wire_bytes) {
+                                            std::size_t wire_bytes, bool largest) {
   MutexLock lock(mutex_);
   probe_bytes_ += wire_bytes;
-  if (!estimator_.addBandwidthProbe(payload_bytes, elapsed_ms)) return false;
+  if (!estimator_.addBandwidthProbe(payload_bytes, elapsed_ms, largest)) return false;
   return reevaluateLocked();
 }
 

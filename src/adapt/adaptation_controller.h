@@ -39,7 +39,9 @@ class AdaptationController {
   // Probe results; each re-evaluates N once latency and bandwidth are both known. `wire_bytes`
   // is what the probe cost on the link (counted in probeBytes()). Return true on a switch.
   bool onLatencyProbe(double rtt_ms, std::size_t wire_bytes);
-  bool onBandwidthProbe(std::size_t payload_bytes, double elapsed_ms, std::size_t wire_bytes);
+  // `largest`: as NetworkEstimator::addBandwidthProbe.
+  bool onBandwidthProbe(std::size_t payload_bytes, double elapsed_ms, std::size_t wire_bytes,
+                        bool largest = true);
   void setMessageBytes(double message_bytes);
 
   // Feeds one estimate of N (ms) directly; true when the configuration changed.

@@ -33,13 +33,19 @@ void NetworkEstimator::addLatencyProbe(double rtt_ms) {
   push(latency_samples_, rtt_ms, window_);
 }
 
-bool NetworkEstimator::addBandwidthProbe(std::size_t bytes, double elapsed_ms) {
+bool NetworkEstimator::resolves(double elapsed_ms) const {
+  const auto latency = latencyMs();
+  return latency && elapsed_ms - *latency >= kMinTransferMs;
+}
+
+bool NetworkEstimator::addBandwidthProbe(std::size_t bytes, double elapsed_ms, bool largest) {
   if (!std::isfinite(elapsed_ms) || elapsed_ms < 0.0) {
     throw std::invalid_argument(
         fmt::format("sized probe time {} ms is not a valid duration", elapsed_ms));
   }
   const auto latency = latencyMs();
   if (!latency || bytes == 0) return false;
+  if (!largest && !resolves(elapsed_ms)) return false;
   const double transfer_ms = std::max(kMinTransferMs, elapsed_ms - *latency);
   push(bandwidth_samples_, static_cast<double>(bytes) * 8.0 / (transfer_ms * 1e3), window_);
   return true;

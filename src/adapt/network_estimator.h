@@ -7,10 +7,12 @@
 // Both are the median of the last `window` samples: one outlier (a retransmission, a scheduler
 // hiccup) cannot move a median of 5, and a lasting change shows after 3 samples.
 // A sized probe that came back no later than the latency estimate says the link moved its bytes
-// faster than the probe can resolve: it counts as a sample at that resolution (the fastest B it
-// could have shown), not as no sample. Dropping such probes kept only the ones a busy edge or a
-// starved client had delayed, and on a fast link their median alone made B look like a few
-// Mbit/s (a loopback link at 6.6 Mbit/s, Table I's last row for a whole KITTI run).
+// faster than the probe can resolve. The caller then sends a larger one at once; a probe of the
+// largest size that still does not resolve counts as a sample at the resolution bound (the fastest
+// B it could show). Dropping such probes for good kept only the ones a busy edge or a starved
+// client had delayed, and on a fast link their median alone made B look like a few Mbit/s (a
+// loopback link at 6.6 Mbit/s, Table I's last row for a whole KITTI run); counting every small
+// one at the bound made a jittery link look far faster than it is (wifi24: 393 for 50 Mbit/s).
 #include <cstddef>
 #include <deque>
 #include <optional>
@@ -26,9 +28,13 @@ class NetworkEstimator {
 
   // Throws std::invalid_argument for a negative or non-finite RTT.
   void addLatencyProbe(double rtt_ms);
-  // `bytes` sent and acknowledged in `elapsed_ms`. Ignored (returns false) until a latency
-  // estimate exists, or for an empty probe.
-  bool addBandwidthProbe(std::size_t bytes, double elapsed_ms);
+  // Whether a sized probe answered in `elapsed_ms` shows a transfer time above the resolution
+  // (false until a latency estimate exists).
+  bool resolves(double elapsed_ms) const;
+  // `bytes` sent and acknowledged in `elapsed_ms`; `largest`: no larger probe will be sent.
+  // Returns whether it became a sample: not until a latency estimate exists, not for an empty
+  // probe, and not for one too fast to resolve unless it is the largest.
+  bool addBandwidthProbe(std::size_t bytes, double elapsed_ms, bool largest = true);
 
   std::optional<double> latencyMs() const;
   std::size_t latencySampleCount() const { return latency_samples_.size(); }

@@ -216,26 +216,36 @@ void AdaptationLoop::probeBandwidth() {
     MutexLock lock(state_mutex_);
     bandwidth = estimator_.bandwidthMbps();
   }
-  const std::size_t payload = scheduler_.sizedProbeBytes(bandwidth);
+  const std::size_t largest = options_.schedule.sized_max_bytes;
   const std::size_t reply = options_.schedule.small_payload_bytes;
-  const ProbeOutcome outcome = timedProbe(payload, reply);
-  if (outcome.unreachable) return;
-  double elapsed_ms = outcome.elapsed_ms;
-  {
-    MutexLock lock(state_mutex_);
-    if (!outcome.answered) {
-      // The link moved fewer than `payload` bytes in the whole timeout, on top of its latency
-      // (which may itself be made of timeouts): B <= payload / timeout.
-      elapsed_ms += estimator_.latencyMs().value_or(0.0);
+  // A probe too fast to resolve is followed at once by one twice as large, up to the largest.
+  for (std::size_t payload = scheduler_.sizedProbeBytes(bandwidth);;
+       payload = std::min(largest, 2 * payload)) {
+    const ProbeOutcome outcome = timedProbe(payload, reply);
+    if (outcome.unreachable) return;
+    double elapsed_ms = outcome.elapsed_ms;
+    const bool at_largest = payload >= largest;
+    bool resolved = true;
+    {
+      MutexLock lock(state_mutex_);
+      if (!outcome.answered) {
+        // The link moved fewer than `payload` bytes in the whole timeout, on top of its latency
+        // (which may itself be made of timeouts): B <= payload / timeout.
+        elapsed_ms += estimator_.latencyMs().value_or(0.0);
+      }
+      ++bandwidth_probes_;
+      resolved = !estimator_.latencyMs() || estimator_.resolves(elapsed_ms);
+      estimator_.addBandwidthProbe(payload, elapsed_ms, at_largest);
     }
-    ++bandwidth_probes_;
-    estimator_.addBandwidthProbe(payload, elapsed_ms);
-  }
-  if (options_.adapt) {
-    publishIfSwitched(
-        controller_.onBandwidthProbe(payload, elapsed_ms, estimatedProbeWireBytes(payload, reply)));
-  } else {
-    logWouldBeRow();
+    if (options_.adapt) {
+      publishIfSwitched(controller_.onBandwidthProbe(
+          payload, elapsed_ms, estimatedProbeWireBytes(payload, reply), at_largest));
+    } else {
+      logWouldBeRow();
+    }
+    if (resolved || at_largest) return;
+    MutexLock wake_lock(wake_mutex_);
+    if (stopping_) return;
   }
 }
 

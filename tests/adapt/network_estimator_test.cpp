@@ -26,9 +26,14 @@ TEST(NetworkEstimator, NeedsLatencyBeforeBandwidth) {
   EXPECT_TRUE(estimator.addBandwidthProbe(10000, 12.0));
   EXPECT_NEAR(*estimator.bandwidthMbps(), 40.0, 1e-9);
   EXPECT_NEAR(*estimator.networkTimeMs(100e3), 30.0, 1e-9);
-  // A probe no slower than the RTT moved its bytes faster than it can resolve: a sample at the
-  // resolution bound (10 kB in 0.05 ms = 1600 Mbit/s), on the fast side of the median.
-  EXPECT_TRUE(estimator.addBandwidthProbe(10000, 9.0));
+  // A probe no slower than the RTT moved its bytes faster than it can resolve: no sample while a
+  // larger probe can follow; the largest counts at the resolution bound (10 kB in 0.05 ms =
+  // 1600 Mbit/s), on the fast side of the median.
+  EXPECT_FALSE(estimator.resolves(9.0));
+  EXPECT_TRUE(estimator.resolves(12.0));
+  EXPECT_FALSE(estimator.addBandwidthProbe(10000, 9.0, /*largest=*/false));
+  EXPECT_NEAR(*estimator.bandwidthMbps(), 40.0, 1e-9);
+  EXPECT_TRUE(estimator.addBandwidthProbe(10000, 9.0, /*largest=*/true));
   EXPECT_NEAR(*estimator.bandwidthMbps(), (40.0 + 1600.0) / 2, 1e-9);
   EXPECT_FALSE(estimator.addBandwidthProbe(0, 20.0));
   EXPECT_THROW(estimator.addLatencyProbe(-1.0), std::invalid_argument);

@@ -8,8 +8,10 @@
 #include <chrono>
 #include <cstdio>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include "geometry/camera.h"
 #include "linkem/link_emulator.h"
@@ -224,6 +226,59 @@ TEST(AdaptationLoop, UnansweredProbesCountAsAVerySlowLink) {
   EXPECT_GE(loop.counters().failed_probes, 2u);
   EXPECT_GE(*loop.estimates().latency_ms, 400.0);
   loop.stop();
+}
+
+TEST(AdaptationLoop, AProbeTooFastToResolveIsFollowedByALargerOne) {
+  // A 1 Gbit/s link with a 1 ms RTT: 4 KiB cross in 0.03 ms, below the 0.05 ms the estimator
+  // resolves; the loop doubles the probe at once until one shows its transfer time (8 KiB).
+  AdaptationLoopOptions options = fastOptions(5000.0);
+  options.schedule.sized_target_ms = 0.01;  // sized from the estimate: the smallest, 4 KiB
+  std::mutex mutex;
+  std::vector<std::size_t> sizes;
+  AdaptationLoop::ProbeFunction link = [&](std::size_t payload, std::size_t, milliseconds) {
+    {
+      std::lock_guard lock(mutex);
+      sizes.push_back(payload);
+    }
+    ProbeResult result;
+    result.round_trip_ms = 1.0 + static_cast<double>(payload) * 8.0 / 1e6;  // 1000 Mbit/s
+    result.sent_bytes = payload;
+    result.received_bytes = 32;
+    return std::optional<ProbeResult>(result);
+  };
+  AdaptationLoop loop(link, options);
+  loop.start();
+  ASSERT_TRUE(
+      eventually([&] { return loop.estimates().bandwidth_mbps.has_value(); }, milliseconds(5000)));
+  loop.stop();
+  EXPECT_NEAR(*loop.estimates().bandwidth_mbps, 1000.0, 10.0);
+  std::lock_guard lock(mutex);
+  std::vector<std::size_t> sized;
+  for (const std::size_t s : sizes) {
+    if (s > options.schedule.small_payload_bytes) sized.push_back(s);
+  }
+  ASSERT_GE(sized.size(), 2u);
+  EXPECT_EQ(sized[0], 4096u);
+  EXPECT_EQ(sized[1], 8192u);
+}
+
+TEST(AdaptationLoop, AProbeTooFastAtTheLargestSizeCountsAtTheBound) {
+  // Loopback answers every size within the RTT: the loop climbs to 64 KiB and counts that one at
+  // the resolution bound (64 KiB in 0.05 ms), so a fast link reads fast.
+  AdaptationLoopOptions options = fastOptions(60000.0);
+  AdaptationLoop::ProbeFunction loopback = [](std::size_t payload, std::size_t, milliseconds) {
+    ProbeResult result;
+    result.round_trip_ms = 1.0;
+    result.sent_bytes = payload;
+    result.received_bytes = 32;
+    return std::optional<ProbeResult>(result);
+  };
+  AdaptationLoop loop(loopback, options);
+  loop.start();
+  ASSERT_TRUE(eventually([&] { return loop.row() == 0; }, milliseconds(5000)))
+      << "N " << loop.estimates().network_time_ms.value_or(-1.0);
+  loop.stop();
+  EXPECT_NEAR(*loop.estimates().bandwidth_mbps, 65536 * 8.0 / 50.0, 1.0);
 }
 
 TEST(AdaptationLoop, AnOutageOfTheEdgeIsNoSampleOfTheLink) {
