@@ -23,12 +23,11 @@ import time
 
 from docs_block import replace_block
 from host_check import host_check, host_line
-from link_experiments import free_port, stop_process, wait_for_port
+from pinned_run import CLIENT_CPU, SERVER_CPU, run_pinned
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DOCS = os.path.join(ROOT, "docs", "benchmarks.md")
 BEGIN, END = "<!-- PACING:BEGIN -->", "<!-- PACING:END -->"
-CLIENT_CPU, SERVER_CPU = 0, 1
 OUTLIER_RATIO = 1.5
 LOST_RATIO = 0.9  # of the cell's best tracked share
 
@@ -42,39 +41,11 @@ ROWS = {
 
 
 def run_once(args, dataset, sensor, mode, pacing, out):
-    exe = os.path.join(args.build, "edgeslam")
-    common = ["--dataset", dataset, "--sensor", sensor, f"--{pacing}", "--out", out,
-              "--maps", "none"]
+    common = ["--dataset", dataset, "--sensor", sensor, f"--{pacing}", "--out", out]
     if args.max_frames:
         common += ["--max-frames", str(args.max_frames)]
-    server = None
-    log = open(os.path.join(out, "run.log"), "w")
-    try:
-        if mode == "edge":
-            port = free_port()
-            server = subprocess.Popen(
-                ["taskset", "-c", str(SERVER_CPU), exe, "server", "--listen", f"127.0.0.1:{port}",
-                 "--maps", "none", "--status-every", "0"],
-                stdout=open(os.path.join(out, "server.log"), "w"), stderr=subprocess.STDOUT)
-            wait_for_port(port, server)
-            cmd = [exe, "client", "--server", f"127.0.0.1:{port}"] + common
-        else:
-            cmd = [exe, "run", "--mode", "local"] + common
-        start = time.monotonic()
-        rc = subprocess.run(["taskset", "-c", str(CLIENT_CPU)] + cmd, stdout=log,
-                            stderr=subprocess.STDOUT).returncode
-        wall = time.monotonic() - start
-    finally:
-        if server:
-            stop_process(server)
-        log.close()
-    if rc != 0:
-        print(f"  run failed ({rc}); see {out}/run.log", file=sys.stderr)
-        return None
-    with open(os.path.join(out, "metrics.json")) as f:
-        metrics = json.load(f)
-    metrics["bench_wall_s"] = wall
-    return metrics
+    return run_pinned(os.path.join(args.build, "edgeslam"), mode, common, out,
+                      server_args=["--status-every", "0"])
 
 
 def kitti_metric(args, dataset, trajectory):

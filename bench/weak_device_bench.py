@@ -30,15 +30,14 @@ import time
 
 from host_check import host_check, host_line
 from docs_block import replace_block
-from link_experiments import (PALETTE, Panel, free_port, legend, stop_process, svg_document,
-                              wait_for_port, write)
+from link_experiments import PALETTE, Panel, legend, svg_document, write
+from pinned_run import CLIENT_CPU, SERVER_CPU, run_pinned
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DOCS = os.path.join(ROOT, "docs", "benchmarks.md")
 FIGURES = os.path.join(ROOT, "docs", "figures")
 BEGIN, END = "<!-- WEAK-DEVICE:BEGIN -->", "<!-- WEAK-DEVICE:END -->"
 PERIOD_US = 10000
-CLIENT_CPU, SERVER_CPU = 0, 1
 # (label, mode, compute adaptation)
 VARIANTS = [("local", "local", True), ("edge", "edge", True), ("edge, no compute adaptation",
                                                                 "edge", False)]
@@ -110,30 +109,8 @@ def run_cell(args, sensor, quota, mode, compute_adapt, out_dir):
     common = ["--dataset", args.dataset, "--sensor", sensor, "--realtime", "--preload",
               "--max-frames", str(args.frames), "--out", out_dir,
               "--compute-adapt", "on" if compute_adapt else "off"]
-    exe = os.path.join(args.build, "edgeslam")
-    server = None
-    log = open(os.path.join(out_dir, "client.log"), "w")
-    try:
-        if mode == "edge":
-            port = free_port()
-            server = subprocess.Popen(
-                ["taskset", "-c", str(SERVER_CPU), exe, "server", "--listen",
-                 f"127.0.0.1:{port}", "--maps", "none", "--semantic", "off"],
-                stdout=open(os.path.join(out_dir, "server.log"), "w"), stderr=subprocess.STDOUT)
-            wait_for_port(port, server)
-            cmd = [exe, "client", "--server", f"127.0.0.1:{port}"] + common
-        else:
-            cmd = [exe, "run", "--mode", "local", "--maps", "none"] + common
-        rc = subprocess.run(quota.wrap(cmd), stdout=log, stderr=subprocess.STDOUT).returncode
-    finally:
-        if server:
-            stop_process(server)
-        log.close()
-    if rc != 0:
-        print(f"  run failed ({rc}); see {out_dir}/client.log", file=sys.stderr)
-        return None
-    with open(os.path.join(out_dir, "metrics.json")) as f:
-        return json.load(f)
+    return run_pinned(os.path.join(args.build, "edgeslam"), mode, common, out_dir, quota.wrap,
+                      server_args=["--semantic", "off"], log_name="client.log")
 
 
 def camera_seconds(metrics):
