@@ -22,8 +22,9 @@ namespace edgeslam::cli {
 namespace {
 
 // Maps started after a loss that no merge joined back (each merge joins one; never negative).
-std::size_t unmergedMaps(std::size_t started, std::uint64_t merges) {
-  return started > merges ? started - static_cast<std::size_t>(merges) : 0;
+std::size_t unmergedMaps(const std::vector<std::size_t>& started,
+                         const std::vector<LoopFramesRecord>& loops) {
+  return started.size() - mapsTiedBack(started, loops);
 }
 
 // Frames by the age of their mask: median / p90 / max and coarse buckets (docs/semantic.md).
@@ -97,9 +98,9 @@ RunReport::RunReport(const RunSetup& setup, const PlayedFrames& played, const Sl
        .map_built =
            !diagnostics_ || diagnostics_->initialized_at_frame.has_value() || options.localize_only,
        .refusals = diagnostics_ ? refusalSummary(*diagnostics_) : std::string(),
-       // Merges are counted where the back end runs in-process (local mode).
-       .maps_unmerged = options.mode == "local"
-                            ? unmergedMaps(slam.mapsStartedAt().size(), counters_.map.merges)
+       // Merges are counted in-process (local mode) or told in slices (edge mode).
+       .maps_unmerged = options.mode == "local" || options.mode == "edge"
+                            ? unmergedMaps(slam.mapsStartedAt(), counters_.map.loop_frames)
                             : 0});
   if (std::string store_warning = storeWarning(store_metrics_, slam.keyFrameCount());
       !store_warning.empty()) {
@@ -143,6 +144,7 @@ nlohmann::json RunReport::commonMetrics() const {
           {"map_resets", slam_.mapResets()},
           {"maps_started_at", slam_.mapsStartedAt()},
           {"map_merges", counters_.map.merges},
+          {"maps_tied_back", mapsTiedBack(slam_.mapsStartedAt(), counters_.map.loop_frames)},
           {"tracked_in_discarded_maps", played_.tracked_in_discarded_maps},
           {"mode", options.mode},
           {"requested_mode", options.mode},
@@ -273,11 +275,13 @@ void RunReport::printSummary() const {
       slam_.keyFrameCount(), slam_.mapPointCount(), slam_.relocalizations(),
       slam_.trackingRecoveries(), slam_.mapResets());
   if (const std::vector<std::size_t> started = slam_.mapsStartedAt(); !started.empty()) {
-    fmt::print("  new maps     {} started after tracking was lost for good (at frames {}), {}\n",
-               started.size(), fmt::join(started, ", "),
-               options.mode == "local"
-                   ? fmt::format("{} merged back by a loop", counters_.map.merges)
-                   : std::string("merges in the edge's log"));
+    fmt::print(
+        "  new maps     {} started after tracking was lost for good (at frames {}), {}\n",
+        started.size(), fmt::join(started, ", "),
+        options.mode == "local" || options.mode == "edge"
+            ? fmt::format("{} tied back by a loop ({} by a merge of two parts)",
+                          mapsTiedBack(started, counters_.map.loop_frames), counters_.map.merges)
+            : std::string("merges in the edge's log"));
   }
   if (diagnostics_ && diagnostics_->refusals != decltype(diagnostics_->refusals){}) {
     const std::string refused = refusalSummary(*diagnostics_);

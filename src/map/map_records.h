@@ -105,6 +105,13 @@ struct MaskRecord {
   double segmentation_ms = 0.0;  // the edge's time to segment the keyframe
 };
 
+// A loop closed between two keyframes of one client: the frames they were made at.
+struct LoopFramesRecord {
+  std::uint64_t current_frame = 0;
+  std::uint64_t loop_frame = 0;
+  bool operator==(const LoopFramesRecord&) const = default;
+};
+
 // Edge -> client: the answer to a localization_query upload.
 struct LocalizationAnswer {
   std::uint64_t frame_index = 0;
@@ -141,6 +148,10 @@ struct MapSlice {
   std::optional<SE3d> reference_pose;  // T_cw of the reference keyframe after optimisation
   std::vector<MaskRecord> masks;
   std::uint32_t loops_closed = 0;  // loops closed on the edge since the last slice
+  // Of those, loops that moved the part of the map this client was mapping in onto another part.
+  std::uint32_t maps_merged = 0;
+  // This client's loops closed since the last slice (both ends its keyframes).
+  std::vector<LoopFramesRecord> loops;
   // Size of the edge's global map when the slice was built (0 = not said: an older edge).
   std::uint64_t map_keyframes = 0;
   std::uint64_t map_points = 0;

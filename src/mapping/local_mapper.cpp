@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <unordered_set>
 
 #include "map/map_matching.h"
 #include "map/pair_triangulation.h"
@@ -187,10 +188,23 @@ void LocalMapper::linkKeyFrame(KeyFrame* keyframe) {
 void LocalMapper::observeRecentPoints(KeyFrame* keyframe) {
   // Only the keyframe's own client's: another client's recent points may be in another part of
   // the map, in another frame, where a projection matches by chance.
+  // And only those seen from the keyframe's covisibility neighbourhood (two links deep): a keyframe
+  // that starts a new map after its client was lost for good is placed where the old map's last
+  // recent points still project, and observing them would join the two maps by chance, before a
+  // loop can merge them as a whole.
+  std::unordered_set<KeyFrameId> near{keyframe->id()};
+  for (const auto& [kf, weight] : keyframe->connections()) {
+    near.insert(kf->id());
+    for (const auto& [kf2, weight2] : kf->connections()) near.insert(kf2->id());
+  }
+  const auto seenNear = [&](const MapPoint* p) {
+    return std::any_of(p->observations().begin(), p->observations().end(),
+                       [&](const auto& observation) { return near.contains(observation.first); });
+  };
   std::vector<MapPoint*> candidates;
   for (MapPoint* p : recent_points_) {
     if (!p->isBad() && idOrigin(p->firstKeyFrameId()) == idOrigin(keyframe->id()) &&
-        !p->observations().contains(keyframe->id())) {
+        !p->observations().contains(keyframe->id()) && seenNear(p)) {
       candidates.push_back(p);
     }
   }

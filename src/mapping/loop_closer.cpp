@@ -57,6 +57,12 @@ LoopCloserStats LoopCloser::stats() const {
   return stats_;
 }
 
+std::vector<LoopEvent> LoopCloser::eventsFrom(std::size_t first) const {
+  MutexLock lock(stats_mutex_);
+  if (first >= stats_.events.size()) return {};
+  return {stats_.events.begin() + static_cast<std::ptrdiff_t>(first), stats_.events.end()};
+}
+
 void LoopCloser::processAll() {
   if (options_.threaded) {
     waitUntilIdle();

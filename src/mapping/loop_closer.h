@@ -119,6 +119,8 @@ class LoopCloser {
 
   std::size_t loops() const { return loops_.load(); }
   LoopCloserStats stats() const;
+  // The loops closed from the `first`-th on (stats().events without copying the rest).
+  std::vector<LoopEvent> eventsFrom(std::size_t first) const;
   // Why the loop-closing thread (or a global BA thread) ended with an exception; nullopt if not.
   std::optional<std::string> failure() const;
 

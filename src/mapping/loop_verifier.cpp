@@ -51,24 +51,95 @@ void keepInliers(const MatchSet& set, const Flags& is_inlier, std::vector<MapPoi
   }
 }
 
-// One Sim3Match per entry of `matched` whose loop point the loop keyframe observes.
-MatchSet toSim3Matches(const KeyFrame& current, const KeyFrame& loop,
+// One Sim3Match per entry of `matched`, in the loop keyframe's camera frame. A loop point the loop
+// keyframe does not observe (one of its window's) is given its projection there as the
+// observation, at the current keyframe's noise; one behind the loop camera is left out.
+MatchSet toSim3Matches(const KeyFrame& current, const KeyFrame& loop, const PinholeCamera& camera,
                        const std::vector<MapPoint*>& matched) {
   MatchSet out;
   for (std::size_t i = 0; i < matched.size(); ++i) {
     MapPoint* loop_point = matched[i];
     MapPoint* own = current.point(i);
     if (loop_point == nullptr || own == nullptr || own->isBad() || loop_point->isBad()) continue;
+    const Eigen::Vector3d in_loop = loop.pose() * loop_point->position();
+    Eigen::Vector2d pixel2;
+    double sigma2 = 0.0;
     const auto obs = loop_point->observations().find(loop.id());
-    if (obs == loop_point->observations().end()) continue;
-    const std::size_t j = obs->second.index;
-    out.matches.push_back({current.pose() * own->position(), loop.pose() * loop_point->position(),
-                           pixelOf(current, i), pixelOf(loop, j), sigmaOf(current, i),
-                           sigmaOf(loop, j)});
+    if (obs != loop_point->observations().end()) {
+      pixel2 = pixelOf(loop, obs->second.index);
+      sigma2 = sigmaOf(loop, obs->second.index);
+    } else {
+      if (!(in_loop.z() > 0.0)) continue;
+      pixel2 = {camera.fx() * in_loop.x() / in_loop.z() + camera.cx(),
+                camera.fy() * in_loop.y() / in_loop.z() + camera.cy()};
+      sigma2 = sigmaOf(current, i);
+    }
+    out.matches.push_back({current.pose() * own->position(), in_loop, pixelOf(current, i), pixel2,
+                           sigmaOf(current, i), sigma2});
     out.current_index.push_back(i);
     out.loop_point.push_back(loop_point);
   }
   return out;
+}
+
+// The candidate and its best covisible keyframes, those good and not connected to the current
+// keyframe (their points would match the current keyframe's own and pull towards no correction).
+std::vector<KeyFrame*> windowOf(KeyFrame* candidate, const KeyFrame& current,
+                                std::size_t covisibles) {
+  std::vector<KeyFrame*> window{candidate};
+  if (covisibles == 0) return window;
+  for (KeyFrame* kf : candidate->bestCovisibles(covisibles)) {
+    if (kf == nullptr || kf->isBad() || kf == &current || current.connections().contains(kf)) {
+      continue;
+    }
+    window.push_back(kf);
+  }
+  return window;
+}
+
+// Bag-of-words matches of the current keyframe's points against each keyframe of the window in
+// turn; a current keypoint keeps its first match and a window point is matched once (a point of
+// the candidate's covisibles that the current keyframe observes is not a match). Returns the
+// number of matches written into `matched`.
+int matchWindowByBow(const KeyFrame& current, const FeatureVector& current_features,
+                     const FrameFeatures& fc, const std::vector<KeyFrame*>& window,
+                     const LoopDetector& detector, const BowMatchOptions& options,
+                     std::vector<MapPoint*>& matched) {
+  std::unordered_set<const MapPoint*> used;
+  int count = 0;
+  for (KeyFrame* kf : window) {
+    const KeyFrameBow* bow = detector.bowOf(kf->id());
+    if (bow == nullptr) continue;
+    const FrameFeatures& fk = kf->features();
+    const auto matches =
+        matchByBow(current_features, fc.keypoints, fc.descriptors,
+                   withPointsOnly(bow->features, *kf), fk.keypoints, fk.descriptors, options);
+    for (const cv::DMatch& m : matches) {
+      MapPoint* p = kf->point(static_cast<std::size_t>(m.trainIdx));
+      if (p == nullptr || p->isBad()) continue;
+      if (kf != window.front() && p->observations().contains(current.id())) continue;
+      MapPoint*& slot = matched[static_cast<std::size_t>(m.queryIdx)];
+      if (slot != nullptr || !used.insert(p).second) continue;
+      slot = p;
+      ++count;
+    }
+  }
+  return count;
+}
+
+// Every good point of the given keyframes, each once, but those `except` observes.
+std::vector<MapPoint*> pointsOf(const std::vector<KeyFrame*>& keyframes,
+                                const KeyFrame* except = nullptr) {
+  std::vector<MapPoint*> points;
+  std::unordered_set<const MapPoint*> seen;
+  for (KeyFrame* kf : keyframes) {
+    for (MapPoint* p : kf->points()) {
+      if (p == nullptr || p->isBad() || !seen.insert(p).second) continue;
+      if (except != nullptr && p->observations().contains(except->id())) continue;
+      points.push_back(p);
+    }
+  }
+  return points;
 }
 
 }  // namespace
@@ -96,27 +167,19 @@ LoopVerification verifyLoopCandidates(KeyFrame* current, const std::vector<KeyFr
       reject("gone");
       continue;
     }
-    const FrameFeatures& fl = candidate->features();
-    const auto bow_matches = matchByBow(current_features, fc.keypoints, fc.descriptors,
-                                        withPointsOnly(candidate_bow->features, *candidate),
-                                        fl.keypoints, fl.descriptors, options.bow);
+    const std::vector<KeyFrame*> window = windowOf(candidate, *current, options.window_keyframes);
     std::vector<MapPoint*> matched(current->size(), nullptr);
-    int bow_count = 0;
-    for (const cv::DMatch& m : bow_matches) {
-      MapPoint* p = candidate->point(static_cast<std::size_t>(m.trainIdx));
-      if (p == nullptr || p->isBad()) continue;
-      matched[static_cast<std::size_t>(m.queryIdx)] = p;
-      ++bow_count;
-    }
+    const int bow_count =
+        matchWindowByBow(*current, current_features, fc, window, detector, options.bow, matched);
     if (bow_count < options.min_bow_matches) {
-      reject(fmt::format("{} BoW matches", bow_count));
+      reject(fmt::format("{} BoW matches over {} keyframes", bow_count, window.size()));
       continue;
     }
 
-    MatchSet set = toSim3Matches(*current, *candidate, matched);
+    MatchSet set = toSim3Matches(*current, *candidate, camera, matched);
     Sim3SolverOptions ransac;
     ransac.fix_scale = options.fix_scale;
-    ransac.min_inliers = options.min_sim3_inliers;
+    ransac.min_inliers = options.min_ransac_inliers;
     const Sim3Result estimate = solveSim3Ransac(set.matches, K, K, ransac);
     if (!estimate.success) {
       reject(fmt::format("{} BoW matches, RANSAC failed ({})", bow_count, estimate.reason));
@@ -127,7 +190,12 @@ LoopVerification verifyLoopCandidates(KeyFrame* current, const std::vector<KeyFr
 
     searchBySim3(*current, *candidate, estimate.cam1_from_cam2, camera, matched,
                  options.guided_radius, kGuidedMaxDistance);
-    set = toSim3Matches(*current, *candidate, matched);
+    if (window.size() > 1) {
+      searchByProjectionSim3(*current, estimate.cam1_from_cam2 * Sim3d(candidate->pose()), camera,
+                             pointsOf(window, current), matched, options.guided_radius,
+                             kProjectionMaxDistance);
+    }
+    set = toSim3Matches(*current, *candidate, camera, matched);
     Sim3RefinementOptions refine;
     refine.fix_scale = options.fix_scale;
     refine.min_inliers = options.min_sim3_inliers;
@@ -152,12 +220,7 @@ LoopVerification verifyLoopCandidates(KeyFrame* current, const std::vector<KeyFr
     for (const auto& [kf, weight] : candidate->connections()) {
       if (!kf->isBad()) loop.loop_keyframes.push_back(kf);
     }
-    std::unordered_set<const MapPoint*> seen;
-    for (KeyFrame* kf : loop.loop_keyframes) {
-      for (MapPoint* p : kf->points()) {
-        if (p != nullptr && !p->isBad() && seen.insert(p).second) loop.loop_points.push_back(p);
-      }
-    }
+    loop.loop_points = pointsOf(loop.loop_keyframes);
     loop.matched = std::move(matched);
     searchByProjectionSim3(*current, loop.S_cw, camera, loop.loop_points, loop.matched,
                            options.projection_radius, kProjectionMaxDistance);

@@ -194,6 +194,12 @@ void EdgeSlam::onSlice(MapSlice slice) {
   MutexLock lock(stats_mutex_);
   ++slices_applied_;
   loops_ += slice.loops_closed;
+  merges_ += slice.maps_merged;
+  loop_frames_.insert(loop_frames_.end(), slice.loops.begin(), slice.loops.end());
+  if (slice.maps_merged > 0) {
+    spdlog::info("the edge merged the map this client is in onto another part (slice {})",
+                 slice.sequence);
+  }
   if (slice.map_keyframes > 0 || slice.map_points > 0) {
     edge_map_keyframes_ = slice.map_keyframes;
     edge_map_points_ = slice.map_points;
@@ -311,6 +317,8 @@ SlamCounters EdgeSlam::counters() const {
   MutexLock lock(stats_mutex_);
   out.exchange.slices_applied = slices_applied_;
   out.map.loops = loops_;
+  out.map.merges = merges_;
+  out.map.loop_frames = loop_frames_;
   out.exchange.slice_latency_ms = slice_latency_ms_.summary();
   out.exchange.slice_apply_ms = slice_apply_ms_.summary();
   out.semantic.keyframes_segmented = keyframes_segmented_;

@@ -71,6 +71,8 @@ class EdgeSlam : public TrackingSlam {
   SampleStats slice_apply_ms_ GUARDED_BY(stats_mutex_);
   std::uint64_t slices_applied_ GUARDED_BY(stats_mutex_) = 0;
   std::uint64_t loops_ GUARDED_BY(stats_mutex_) = 0;
+  std::uint64_t merges_ GUARDED_BY(stats_mutex_) = 0;  // loops that moved this client's part
+  std::vector<LoopFramesRecord> loop_frames_ GUARDED_BY(stats_mutex_);
   std::uint64_t keyframes_segmented_ GUARDED_BY(stats_mutex_) = 0;
   SampleStats segmentation_ms_ GUARDED_BY(stats_mutex_);
   std::uint64_t edge_map_keyframes_ GUARDED_BY(stats_mutex_) =

@@ -74,6 +74,11 @@ SlamCounters LocalSlam::counters() const {
   const MappingBackendCounters backend = backend_->counters();
   out.map.loops = backend.loops;
   out.map.merges = backend.merges;
+  if (const LoopCloser* closer = backend_->loopCloser(); closer != nullptr) {
+    for (const LoopEvent& event : closer->eventsFrom(0)) {
+      out.map.loop_frames.push_back({event.current_frame, event.loop_frame});
+    }
+  }
   addClientCounters(out);
   if (backend_->segments()) {
     out.semantic.keyframes_segmented = backend.keyframes_segmented;

@@ -2,8 +2,11 @@
 // What a run mode counts, grouped by what it measures. Each group is zero where the mode has none
 // of it (local mode exchanges nothing; offload tracks nothing on the client).
 #include <array>
+#include <cstddef>
 #include <cstdint>
+#include <vector>
 
+#include "map/map_records.h"
 #include "modes/paced_keyframe_sink.h"
 #include "util/timing_stats.h"
 
@@ -52,13 +55,33 @@ struct ClientStageSummary {
 struct MapCounters {
   std::uint64_t loops = 0;
   // Loops that joined two parts of the map (a map started after tracking was lost for good, met
-  // again); counted where the back end runs in-process (local mode).
+  // again): in local mode every one, in edge mode those that moved this client's part.
   std::uint64_t merges = 0;
+  // The frames at both ends of each loop (edge mode: of this client's loops).
+  std::vector<LoopFramesRecord> loop_frames;
   // Monocular: median scene depth of the last quarter of the keyframes over that of the first
   // quarter (0 when there are too few keyframes). Along a drive the scene's depth stays about the
   // same, so a map whose scale drifts shows it here (a cheap hint, no ground truth needed).
   double keyframe_depth_ratio = 0.0;
 };
+
+// How many of the maps started after tracking was lost for good (at these frames) a loop tied back
+// to a place seen before their start: a loop from a frame at or after the start to one before it.
+// A tie is what counts, whether the loop merged two separate parts or the parts had met already
+// through tracking (a relocalisation or a shared point) and the loop corrected the seam.
+inline std::size_t mapsTiedBack(const std::vector<std::size_t>& started_at,
+                                const std::vector<LoopFramesRecord>& loops) {
+  std::size_t tied = 0;
+  for (const std::size_t start : started_at) {
+    for (const LoopFramesRecord& loop : loops) {
+      if (loop.current_frame >= start && loop.loop_frame < start) {
+        ++tied;
+        break;
+      }
+    }
+  }
+  return tied;
+}
 
 // Localisation through the edge (`--localize-only` in edge mode): the client's questions.
 struct EdgeLocalizationCounters {

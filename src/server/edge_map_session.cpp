@@ -35,7 +35,9 @@ EdgeMapSession::EdgeMapSession(const PinholeCamera& camera, Sensor sensor,
   hooks.keyframe_segmented = [this](KeyFrameSegmentationResult result) {
     onSegmented(std::move(result));
   };
-  hooks.parts_merged = [this](const MapPartMerge& merge) { onPartsMerged(merge); };
+  // The loop closer tells of a merge under the map's update mutex.
+  hooks.parts_merged = [this](const MapPartMerge& merge)
+                           NO_THREAD_SAFETY_ANALYSIS { onPartsMerged(merge); };
   backend_ = std::make_unique<MappingBackend>(map_, camera_, sensor, std::move(options.backend),
                                               std::move(hooks));
   if (options.preload) options.preload(map_);
@@ -323,8 +325,7 @@ std::optional<MapSlice> EdgeMapSession::sliceFor(Client& client, MapSlice slice,
       slice.reference_pose = mapped->pose();
     }
   }
-  slice.loops_closed = static_cast<std::uint32_t>(loops - client.loops_published);
-  client.loops_published = loops;
+  tellLoops(client, loops, slice);
   slice.sequence = ++client.slice_sequence;
   // A correction answers no upload. The slice answers the upload of the keyframe it mapped (later
   // uploads may be queued).
@@ -386,8 +387,7 @@ void EdgeMapSession::publishFullResync(EdgeMapClientId client_id) {
     slice.map_keyframes = map_.keyFrameCount();
     slice.map_points = map_.pointCount();
     const std::size_t loops = backend_->loops();
-    slice.loops_closed = static_cast<std::uint32_t>(loops - client.loops_published);
-    client.loops_published = loops;
+    tellLoops(client, loops, slice);
     slice.sequence = ++client.slice_sequence;
     // newest_keyframe stays unset: the client must not drop observations in its own keyframes
     // that the edge lacks (it re-sends those keyframes).
@@ -416,7 +416,30 @@ void EdgeMapSession::onSegmented(KeyFrameSegmentationResult result) {
   publishSlice(nullptr);
 }
 
+void EdgeMapSession::tellLoops(Client& client, std::size_t loops, MapSlice& slice) {
+  slice.loops_closed = static_cast<std::uint32_t>(loops - client.loops_published);
+  slice.maps_merged = static_cast<std::uint32_t>(client.merges_moved - client.merges_published);
+  client.merges_published = client.merges_moved;
+  if (const LoopCloser* closer = backend_->loopCloser();
+      closer != nullptr && loops > client.loops_published && client.window_centre != kInvalidId) {
+    const std::uint8_t origin = idOrigin(client.window_centre);
+    std::vector<LoopEvent> events = closer->eventsFrom(client.loops_published);
+    events.resize(std::min(events.size(), loops - client.loops_published));
+    for (const LoopEvent& event : events) {
+      if (idOrigin(event.current) != origin || idOrigin(event.loop) != origin) continue;
+      slice.loops.push_back({event.current_frame, event.loop_frame});
+    }
+  }
+  client.loops_published = loops;
+}
+
 void EdgeMapSession::onPartsMerged(const MapPartMerge& merge) {
+  for (auto& [id, client] : clients_) {
+    if (std::find(merge.moved.begin(), merge.moved.end(), client->window_centre) !=
+        merge.moved.end()) {
+      ++client->merges_moved;
+    }
+  }
   MutexLock lock(moves_mutex_);
   part_moves_.push_back({merge.world, {merge.moved.begin(), merge.moved.end()}});
 }

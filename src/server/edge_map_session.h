@@ -136,6 +136,10 @@ class EdgeMapSession {
     ClientMapWindow window;
     KeyFrameId window_centre = kInvalidId;  // its last mapped keyframe
     std::size_t loops_published = 0;
+    // Loops that moved the part this client was mapping in (its last mapped keyframe's) onto
+    // another part, and how many of them its slices told.
+    std::size_t merges_moved = 0;
+    std::size_t merges_published = 0;
     std::uint64_t slice_sequence = 0;
     std::unordered_map<KeyFrameId, std::uint64_t> upload_of_keyframe;
     KeyFrameId newest_keyframe = kInvalidId;
@@ -154,7 +158,9 @@ class EdgeMapSession {
       REQUIRES(map_.updateMutex());
   void adoptPreloadedMap();
   void onSegmented(KeyFrameSegmentationResult result);
-  void onPartsMerged(const MapPartMerge& merge);
+  void onPartsMerged(const MapPartMerge& merge) REQUIRES(map_.updateMutex());
+  // Tells the client in `slice` of the loops closed since its last slice (`loops` in all so far).
+  void tellLoops(Client& client, std::size_t loops, MapSlice& slice) REQUIRES(map_.updateMutex());
   // An upload tracked against a keyframe that a merge has moved since, before its client heard of
   // it, is in the frame the part had: the move it must make (new world point = move * old one),
   // nullopt when it needs none.

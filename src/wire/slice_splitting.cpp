@@ -44,7 +44,8 @@ bool onlyRecords(const MapSlice& s) {
   return s.upload_sequence == 0 && s.processed_keyframe == kInvalidId && !s.full_resync &&
          s.points_erased.empty() && s.keyframe_poses.empty() && s.keyframes_erased.empty() &&
          s.keyframes_evicted.empty() && !s.reference_pose && s.loops_closed == 0 &&
-         s.map_keyframes == 0 && s.map_points == 0 && !s.localization;
+         s.maps_merged == 0 && s.loops.empty() && s.map_keyframes == 0 && s.map_points == 0 &&
+         !s.localization;
 }
 
 std::size_t recordCount(const MapSlice& s) {

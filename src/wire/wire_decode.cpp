@@ -550,6 +550,12 @@ MapSlice fromProto(const v1::MapSlice& in) {
                  "masks");
     for (const v1::Mask& m : in.masks()) out.masks.push_back(fromProto(m));
     out.loops_closed = in.loops_closed();
+    out.maps_merged = in.maps_merged();
+    requireCount(static_cast<std::size_t>(in.loops_size()), wire_limits::kMaxLoopsPerSlice,
+                 "loops");
+    for (const v1::LoopFrames& loop : in.loops()) {
+      out.loops.push_back({loop.current_frame(), loop.loop_frame()});
+    }
     out.keyframes_evicted = decodeIdDeltas(in.keyframes_evicted(), wire_limits::kMaxErasedPerSlice,
                                            "keyframes_evicted");
     out.map_keyframes = in.map_keyframes();

@@ -424,6 +424,12 @@ void toProto(const MapSlice& slice, v1::MapSlice* out, const WireEncodeOptions& 
   if (slice.reference_pose) toProto(*slice.reference_pose, out->mutable_reference_pose());
   for (const MaskRecord& mask : slice.masks) toProto(mask, out->add_masks());
   out->set_loops_closed(slice.loops_closed);
+  out->set_maps_merged(slice.maps_merged);
+  for (const LoopFramesRecord& loop : slice.loops) {
+    v1::LoopFrames* record = out->add_loops();
+    record->set_current_frame(loop.current_frame);
+    record->set_loop_frame(loop.loop_frame);
+  }
   previous = 0;
   for (const KeyFrameId id : slice.keyframes_evicted) {
     out->add_keyframes_evicted(idDelta(id, previous));

@@ -11,6 +11,7 @@ constexpr std::size_t kMaxKeyFramesPerSlice = 20000;
 constexpr std::size_t kMaxObservations = 10000;  // per map point
 constexpr std::size_t kMaxErasedPerSlice = 1000000;
 constexpr std::size_t kMaxMasksPerSlice = 1000;
+constexpr std::size_t kMaxLoopsPerSlice = 1000;
 constexpr std::size_t kMaxClientMapKeyFrames = 100000;  // SessionSettings.client_map_keyframes
 constexpr int kMaxPyramidLevels = 32;
 constexpr int kMaxImageSide = 16384;  // camera and mask width / height

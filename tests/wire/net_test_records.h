@@ -128,6 +128,8 @@ inline MapSlice sampleSlice(std::uint64_t sequence, std::mt19937& rng) {
   s.reference_pose = samplePose(rng);
   s.masks.push_back({clientId(3, 8), 160, 120, "png/4", {0x89, 'P', 'N', 'G', 9}, 131.5});
   s.loops_closed = 2;
+  s.maps_merged = 1;
+  s.loops = {{512, 97}, {530, 440}};
   s.keyframes_evicted = {clientId(3, 5), clientId(3, 6), clientId(0, 1)};
   s.map_keyframes = 321;
   s.map_points = 45678;

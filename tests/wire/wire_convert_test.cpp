@@ -365,6 +365,8 @@ TEST(WireConvert, SliceRoundTrip) {
     EXPECT_EQ(back.masks[0].bytes, s.masks[0].bytes);
     EXPECT_FLOAT_EQ(static_cast<float>(back.masks[0].segmentation_ms), 131.5f);
     EXPECT_EQ(back.loops_closed, s.loops_closed);
+    EXPECT_EQ(back.maps_merged, 1u);
+    EXPECT_EQ(back.loops, s.loops);
     EXPECT_EQ(back.keyframes_evicted, s.keyframes_evicted);
     EXPECT_EQ(back.map_keyframes, 321u);
     EXPECT_EQ(back.map_points, 45678u);
