@@ -32,17 +32,27 @@ int pointsSeenBy(const KeyFrame& keyframe, const KeyFrame& other) {
   return seen;
 }
 
-TEST(RecentPoints, AKeyFrameStartingANewMapDoesNotObserveTheOldMapsRecentPoints) {
-  SyntheticScene scene(400, 11);
-  Map map(1);  // a client's keyframes, as on the edge
-  LocalMapper mapper(map, scene.camera(), edgeOptions());
-  KeyFrame* last_of_old = nullptr;
-  {
-    MutexLock lock(map.updateMutex());
-    last_of_old = scene.addKeyFrame(map, scene.view(poseAt({0, 0, 0}), 4, true), 200, true);
+// An edge mapper that has just mapped one keyframe of a client (its points are recent).
+class RecentPoints : public ::testing::Test {
+ protected:
+  KeyFrame* mapFirstKeyFrame(std::size_t frame_index) {
+    KeyFrame* kf = nullptr;
+    {
+      MutexLock lock(map.updateMutex());
+      kf = scene.addKeyFrame(map, scene.view(poseAt({0, 0, 0}), 4, true), frame_index, true);
+    }
+    mapper.insertKeyFrame(kf);
+    mapper.processAll();
+    return kf;
   }
-  mapper.insertKeyFrame(last_of_old);
-  mapper.processAll();
+
+  SyntheticScene scene{400, 11};
+  Map map{1};  // a client's keyframes, as on the edge
+  LocalMapper mapper{map, scene.camera(), edgeOptions()};
+};
+
+TEST_F(RecentPoints, AKeyFrameStartingANewMapDoesNotObserveTheOldMapsRecentPoints) {
+  KeyFrame* last_of_old = mapFirstKeyFrame(200);
 
   // The new map's first keyframe, at nearly the same pose, with points of its own only.
   KeyFrame* first_of_new = nullptr;
@@ -61,18 +71,8 @@ TEST(RecentPoints, AKeyFrameStartingANewMapDoesNotObserveTheOldMapsRecentPoints)
   EXPECT_FALSE(first_of_new->connections().contains(last_of_old));
 }
 
-TEST(RecentPoints, AKeyFrameOfTheSameMapObservesThemStill) {
-  SyntheticScene scene(400, 12);
-  Map map(1);
-  LocalMapperOptions options = edgeOptions();
-  LocalMapper mapper(map, scene.camera(), options);
-  KeyFrame* previous = nullptr;
-  {
-    MutexLock lock(map.updateMutex());
-    previous = scene.addKeyFrame(map, scene.view(poseAt({0, 0, 0}), 4, true), 10, true);
-  }
-  mapper.insertKeyFrame(previous);
-  mapper.processAll();
+TEST_F(RecentPoints, AKeyFrameOfTheSameMapObservesThemStill) {
+  KeyFrame* previous = mapFirstKeyFrame(10);
 
   // The next keyframe tracked a few of the previous one's points (its client did not have the
   // rest yet): mapping it finds the others.
