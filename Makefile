@@ -37,10 +37,13 @@ vocab: build
 # Tests labelled "timing" measure real delays and rates: they run alone, after the others, and a
 # failure is retried up to four times (a busy or preempted host only ever adds delay, and on the
 # shared VMs that comes in bursts: one fresh-clone run failed the adaptation loop 3 times in a row).
+# A failure prints the end of each failed test's output once more, after ctest's summary (CI
+# shows only the tail of the log).
+FAILED_OUTPUT = { python3 $(CURDIR)/scripts/failed_test_output.py . ; exit 1; }
 test-release: build
-	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) --timeout 900 -LE timing
+	@cd $(BUILD_DIR) && ctest --output-on-failure -j $(JOBS) --timeout 900 -LE timing || $(FAILED_OUTPUT)
 	@cd $(BUILD_DIR) && ctest --output-on-failure --timeout 900 -L timing --repeat until-pass:5 \
-	  -E "$(HOST_SENSITIVE_TESTS)"
+	  -E "$(HOST_SENSITIVE_TESTS)" || $(FAILED_OUTPUT)
 
 # End-to-end timing through the emulated link and the adaptation controller: on the shared VMs a
 # burst of preemption can last the whole test (two fresh-clone runs in a row measured 43-65 ms for
@@ -61,7 +64,7 @@ sanitize-build: deps
 	@cmake --build $(ASAN_DIR) -j $(JOBS) --target unit-tests edgeslam_fuzzers
 
 test-sanitize: sanitize-build
-	@cd $(ASAN_DIR) && ctest --output-on-failure -j $(JOBS) -L unit --timeout 900
+	@cd $(ASAN_DIR) && ctest --output-on-failure -j $(JOBS) -L unit --timeout 900 || $(FAILED_OUTPUT)
 
 # The clang build: -Wthread-safety checks the lock annotations at compile time (warnings are
 # errors), and ThreadSanitizer watches the unit tests run. -O1 with line tables only keeps it quick.
@@ -71,7 +74,7 @@ test-tsan: deps
 	  -DEDGESLAM_TSAN=ON -DEDGESLAM_BUILD_BENCH=OFF -DEDGESLAM_SHARED_DIR=$(EDGESLAM_SHARED) > /dev/null
 	@cmake --build $(TSAN_DIR) -j $(JOBS) --target unit-tests
 	@cd $(TSAN_DIR) && TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 suppressions=$(CURDIR)/tests/tsan.supp" \
-	  ctest --output-on-failure -j $(JOBS) -L unit --timeout 900
+	  ctest --output-on-failure -j $(JOBS) -L unit --timeout 900 || $(FAILED_OUTPUT)
 
 test: test-release
 	@if [ -n "$$CI" ]; then $(MAKE) --no-print-directory test-sanitize fuzz test-tsan; fi

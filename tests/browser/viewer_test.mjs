@@ -35,6 +35,7 @@ if (!args.dataset || !existsSync(args.dataset)) {
 const puppeteer = createRequire(path.resolve(args.modules, 'index.js'))('puppeteer-core');
 
 const children = new Set();
+const outputs = new Map();  // name -> the output of the process last started under that name
 const outDir = mkdtempSync(path.join(tmpdir(), 'edgeslam-browser-'));
 const sleep = (ms) => new Promise((resolve) => setTimeout(resolve, ms));
 
@@ -48,6 +49,7 @@ function start(argv, pattern, name) {
   children.add(child);
   child.on('exit', () => children.delete(child));
   let output = '';
+  outputs.set(name, () => output);
   return new Promise((resolve, reject) => {
     const timer = setTimeout(() => reject(new Error(`${name}: no /${pattern.source}/ in 60 s:\n${output}`)), 60000);
     const onData = (data) => {
@@ -92,14 +94,19 @@ async function waitFor(page, predicate, what, ms = 60000) {
   fail(`timed out waiting for ${what}; page state: ${JSON.stringify(last)}`);
 }
 
+// `frames`: a count from the start, or [range, passes] played that many times over.
 function runArgs(port, frames) {
-  return ['run', '--dataset', args.dataset, '--mode', 'local', '--realtime', '--max-frames', String(frames),
-    '--vocab', 'none', '--viewer', String(port), '--viewer-linger', '60', '--out', path.join(outDir, `run-${port}`)];
+  const play = Array.isArray(frames) ? ['--frames', frames[0], '--repeat', String(frames[1])]
+    : ['--max-frames', String(frames)];
+  return ['run', '--dataset', args.dataset, '--mode', 'local', '--realtime', ...play, '--vocab', 'none',
+    '--viewer', String(port), '--viewer-linger', '60', '--out', path.join(outDir, `run-${port}`)];
 }
 
 async function mobileView(browser) {
-  // Long enough to still run when a slow (loaded) browser gets the page; it is stopped below.
-  const first = await start(runArgs(0, 900), /viewer: (http:\/\/[\d.]+:(\d+)\/)/, 'run');
+  // Plays on until it is stopped below: a loaded host's browser may take most of a minute to get
+  // the page, and a run that had ended by then leaves nothing to update (900 frames, 30 s, were
+  // not always enough in CI).
+  const first = await start(runArgs(0, ['0-599', 10]), /viewer: (http:\/\/[\d.]+:(\d+)\/)/, 'run');
   const [, url, port] = first.match;
   const page = await browser.newPage();
   await page.setViewport({ width: 420, height: 900, deviceScaleFactor: 1 });  // a phone
@@ -195,6 +202,12 @@ try {
   console.log('PASS');
 } catch (e) {
   console.error(`FAIL: ${e.message}`);
+  // What the processes said last: the cause is often there (a crash, a refused session).
+  for (const [name, output] of outputs) {
+    const lines = output().trimEnd().split('\n');
+    console.error(`--- ${name}: the last ${Math.min(lines.length, 15)} lines of its output ---`);
+    console.error(lines.slice(-15).join('\n'));
+  }
   status = 1;
 } finally {
   if (browser) await browser.close().catch(() => {});
