@@ -402,7 +402,9 @@ void addRunOptions(CLI::App* run, const std::shared_ptr<RunOptions>& options) {
   run->add_option("--new-map-after", options->new_map_after_s,
                   "Lost for S seconds (the camera's time) with relocalisation failing, start a new "
                   "map beside the old one; loop closing merges them when the camera sees the old "
-                  "places again (0 = wait for relocalisation; in local mode 3 is a good value)")
+                  "places again. Frames tracked in a new map before it is merged are left out of "
+                  "the trajectories (trajectory_map<k>.tum has them); 0 = wait for "
+                  "relocalisation")
       ->check(CLI::Range(0.0, 3600.0))
       ->capture_default_str();
   auto* max_frames =

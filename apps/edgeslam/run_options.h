@@ -34,8 +34,9 @@ struct RunOptions {
   std::optional<int> segment_refresh_min;  // default: SegmentationRefreshOptions, or the most
   // Lost frames bridged by the motion prediction (TrackerOptions::recover_within_frames).
   std::size_t recover_frames = TrackerOptions{}.recover_within_frames;
-  // Lost this long, a new map is started (TrackerOptions::new_map_after_lost_s; 0 = never).
-  double new_map_after_s = TrackerOptions{}.new_map_after_lost_s;
+  // Lost this long (camera time), a new map is started (TrackerOptions::new_map_after_lost_s;
+  // 0 = never). The library's default waits; a run does not stay lost for good.
+  double new_map_after_s = 3.0;
   std::size_t max_frames = 0;  // 0 = all
   // `--frames A-B[,C-D...]`: only these frames of the dataset, the ranges one after the other.
   std::optional<std::vector<FrameRange>> frames;

@@ -77,6 +77,7 @@ RunReport::RunReport(const RunSetup& setup, const PlayedFrames& played, const Sl
       align_(setup.sensor == Sensor::kMonocular ? AlignMode::kSim3 : AlignMode::kSe3),
       at_time_(slam.trajectoryAtFrameTime()),
       final_(slam.trajectoryFinal()),
+      own_frames_(slam.trajectoriesInOwnFrames()),
       ate_(ateJson(played.ground_truth, at_time_, align_)),
       ate_final_(ateJson(played.ground_truth, final_, align_)),
       counters_(slam.counters()),
@@ -108,6 +109,16 @@ RunReport::RunReport(const RunSetup& setup, const PlayedFrames& played, const Sl
   }
   metrics_ = commonMetrics();
   addModeMetrics();
+}
+
+nlohmann::json RunReport::ownFramesJson() const {
+  std::size_t at_frame_time = 0;
+  std::size_t never_merged = 0;
+  for (const OwnMapTrajectory& own : own_frames_) {
+    at_frame_time += own.poses.size();
+    never_merged += own.never_joined;
+  }
+  return {{"at_frame_time", at_frame_time}, {"never_merged", never_merged}};
 }
 
 nlohmann::json RunReport::commonMetrics() const {
@@ -146,6 +157,7 @@ nlohmann::json RunReport::commonMetrics() const {
           {"map_merges", counters_.map.merges},
           {"maps_tied_back", mapsTiedBack(slam_.mapsStartedAt(), counters_.map.loop_frames)},
           {"tracked_in_discarded_maps", played_.tracked_in_discarded_maps},
+          {"tracked_in_own_frames", ownFramesJson()},
           {"mode", options.mode},
           {"requested_mode", options.mode},
           {"sensor", setup_.sensor_name},
@@ -282,6 +294,14 @@ void RunReport::printSummary() const {
             ? fmt::format("{} tied back by a loop ({} by a merge of two parts)",
                           mapsTiedBack(started, counters_.map.loop_frames), counters_.map.merges)
             : std::string("merges in the edge's log"));
+    const nlohmann::json own = ownFramesJson();
+    if (own["at_frame_time"].get<std::size_t>() > 0) {
+      fmt::print(
+          "  own frames   {} tracked frames were in a new map's own frame at their time (in "
+          "trajectory_map<k>.tum, not in trajectory.tum), {} of them in a map never merged (not "
+          "in trajectory_final.tum either)\n",
+          own["at_frame_time"].get<std::size_t>(), own["never_merged"].get<std::size_t>());
+    }
   }
   if (diagnostics_ && diagnostics_->refusals != decltype(diagnostics_->refusals){}) {
     const std::string refused = refusalSummary(*diagnostics_);
@@ -431,6 +451,16 @@ void RunReport::writeOutputs() const {
   writeTumTrajectory(out_dir / "trajectory.tum", at_time_);
   writeTumTrajectory(out_dir / "trajectory_final.tum", final_);
   writeTumTrajectory(out_dir / "keyframes.tum", slam_.keyframeTrajectory());
+  // A file of an earlier run in the same folder would pass for this run's.
+  for (const auto& entry : std::filesystem::directory_iterator(out_dir)) {
+    const std::string name = entry.path().filename().string();
+    if (name.starts_with("trajectory_map") && name.ends_with(".tum")) {
+      std::filesystem::remove(entry.path());
+    }
+  }
+  for (const OwnMapTrajectory& own : own_frames_) {
+    writeTumTrajectory(out_dir / fmt::format("trajectory_map{}.tum", own.map), own.poses);
+  }
   // For `edgeslam report`: the dataset's poses at the frames the run read.
   if (!played_.ground_truth.empty()) {
     writeTumTrajectory(out_dir / "groundtruth.tum", played_.ground_truth);

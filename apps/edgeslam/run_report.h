@@ -38,6 +38,8 @@ class RunReport {
 
  private:
   nlohmann::json commonMetrics() const;
+  // Frames tracked in a map's own frame: {"at_frame_time", "never_merged"}.
+  nlohmann::json ownFramesJson() const;
   void addModeMetrics();
   nlohmann::json computeBudgetJson() const;
   std::string computeBudgetLine() const;
@@ -51,6 +53,8 @@ class RunReport {
   AlignMode align_;
   Trajectory at_time_;
   Trajectory final_;
+  // Frame-time poses left out of at_time_: a map's own frame (before a merge, or for good).
+  std::vector<OwnMapTrajectory> own_frames_;
   std::optional<nlohmann::json> ate_;
   std::optional<nlohmann::json> ate_final_;
   SlamCounters counters_;

@@ -304,6 +304,7 @@ bool Tracker::initialize(Frame& frame) {
     for (FrameRecord& r : records_) {
       if (r.index == kf0->frameIndex()) {
         r.tracked = true;
+        r.map = static_cast<std::uint32_t>(maps_started_at_.size());  // begun while lost maybe
         r.reference = kf0;
         r.T_cr = SE3d();
         r.T_cw = kf0->pose();
@@ -671,6 +672,7 @@ void Tracker::record(const Frame& frame, bool tracked) {
   r.index = frame.index;
   r.timestamp = frame.timestamp;
   r.tracked = tracked && frame.T_cw.has_value();
+  r.map = static_cast<std::uint32_t>(maps_started_at_.size());
   if (r.tracked) {
     r.T_cw = *frame.T_cw;
     r.reference =

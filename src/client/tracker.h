@@ -5,6 +5,7 @@
 // thread-safe itself, but it holds the map's update mutex while it reads or changes the map, so a
 // mapper may run beside it.
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <vector>
@@ -113,6 +114,9 @@ class Tracker {
     KeyFrame* reference = nullptr;
     SE3d T_cr;  // camera-from-reference-keyframe
     SE3d T_cw;  // the pose estimated at the frame's time
+    // The map the frame was tracked in: 0 the first, k the k-th started after tracking was lost
+    // for good (mapsStartedAt()[k - 1]).
+    std::uint32_t map = 0;
   };
   const std::vector<FrameRecord>& records() const { return records_; }
   // The edge moved the client's bounded map window: evicted keyframes leave the relocalisation

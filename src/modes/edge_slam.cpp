@@ -199,6 +199,10 @@ void EdgeSlam::onSlice(MapSlice slice) {
   if (slice.maps_merged > 0) {
     spdlog::info("the edge merged the map this client is in onto another part (slice {})",
                  slice.sequence);
+    // The edge moves the part without the map's origin, so the other part is an older one: taken
+    // to be the first map's (a client with two maps started after losses, merged onto each
+    // other first, is not told apart).
+    first_map_frame_.currentMapJoinedFirst();
   }
   if (slice.map_keyframes > 0 || slice.map_points > 0) {
     edge_map_keyframes_ = slice.map_keyframes;

@@ -4,6 +4,8 @@
 
 #include <stdexcept>
 
+#include "mapping/map_part_merge.h"
+
 namespace edgeslam {
 
 LocalSlam::LocalSlam(const PinholeCamera& camera, SlamOptions options)
@@ -19,6 +21,15 @@ LocalSlam::LocalSlam(const PinholeCamera& camera, SlamOptions options)
   MappingBackendHooks hooks;
   hooks.keyframe_segmented = [this](KeyFrameSegmentationResult result) {
     semantic_filter_->offerMask(result.frame_index, std::move(result.labels));
+  };
+  // Told under the map's update mutex (held by the loop closer).
+  hooks.parts_merged = [this](const MapPartMerge& merge) NO_THREAD_SAFETY_ANALYSIS {
+    if (!merge.moved_current_side || merge.moved.empty()) return;
+    KeyFrame* origin = map_.originKeyFrame();
+    KeyFrame* moved = map_.keyFrame(merge.moved.front());
+    if (origin != nullptr && moved != nullptr && connectedPart(moved).contains(origin)) {
+      first_map_frame_.currentMapJoinedFirst();
+    }
   };
   backend_ = std::make_unique<MappingBackend>(map_, camera_, options_.sensor, std::move(backend),
                                               std::move(hooks));

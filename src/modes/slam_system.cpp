@@ -124,6 +124,7 @@ TrackResult TrackingSlam::process(std::size_t frame_index, double timestamp, con
   beforeTracking(frame_index, image);
   stage = Stopwatch();
   TrackResult result = tracker_->track(frame_index, timestamp, std::move(features));
+  first_map_frame_.noteProgress(tracker_->records().size(), tracker_->mapsStarted());
   last_stages_.tracking_ms = stage.elapsedMs();
   tracking_ms_.add(last_stages_.tracking_ms);
   stage = Stopwatch();
@@ -155,8 +156,12 @@ void TrackingSlam::addClientCounters(SlamCounters& counters) const {
 
 Trajectory TrackingSlam::trajectoryAtFrameTime() const {
   Trajectory out;
-  for (const auto& r : tracker_->records()) {
-    if (r.tracked) out.push_back({r.timestamp, r.T_cw.inverse()});
+  const auto& records = tracker_->records();
+  for (std::size_t i = 0; i < records.size(); ++i) {
+    const auto& r = records[i];
+    if (r.tracked && first_map_frame_.inFirstAtFrameTime(i, r.map)) {
+      out.push_back({r.timestamp, r.T_cw.inverse()});
+    }
   }
   return out;
 }
@@ -165,8 +170,21 @@ Trajectory TrackingSlam::trajectoryFinal() const {
   MutexLock lock(map_.updateMutex());
   Trajectory out;
   for (const auto& r : tracker_->records()) {
-    if (!r.tracked || r.reference == nullptr) continue;
+    if (!r.tracked || r.reference == nullptr || !first_map_frame_.inFirstFinally(r.map)) continue;
     out.push_back({r.timestamp, (r.T_cr * r.reference->latestPose()).inverse()});
+  }
+  return out;
+}
+
+std::vector<OwnMapTrajectory> TrackingSlam::trajectoriesInOwnFrames() const {
+  std::vector<OwnMapTrajectory> out;
+  const auto& records = tracker_->records();
+  for (std::size_t i = 0; i < records.size(); ++i) {
+    const auto& r = records[i];
+    if (!r.tracked || first_map_frame_.inFirstAtFrameTime(i, r.map)) continue;
+    if (out.empty() || out.back().map != r.map) out.push_back({.map = r.map, .poses = {}});
+    out.back().poses.push_back({r.timestamp, r.T_cw.inverse()});
+    if (!first_map_frame_.inFirstFinally(r.map)) ++out.back().never_joined;
   }
   return out;
 }

@@ -19,6 +19,7 @@
 #include "io/trajectory.h"
 #include "map/map.h"
 #include "mapping/mapping_backend.h"
+#include "modes/first_map_frame.h"
 #include "modes/paced_keyframe_sink.h"
 #include "modes/slam_counters.h"
 #include "modes/split_client_report.h"
@@ -103,6 +104,14 @@ struct MapSample {
   std::size_t total_points = 0;  // in the client's map, of which `points` is a subsample
 };
 
+// The frame-time poses of a map started after tracking was lost for good, in that map's own frame
+// (before a merge moved it onto the first map, or for good when none did).
+struct OwnMapTrajectory {
+  std::uint32_t map = 0;  // k: the k-th map started (SlamSystem::mapsStartedAt()[k - 1])
+  Trajectory poses;
+  std::size_t never_joined = 0;  // of them, frames whose map no merge joined to the first
+};
+
 // One run mode's whole SLAM as the run command drives it.
 class SlamSystem {
  public:
@@ -127,10 +136,14 @@ class SlamSystem {
     return std::nullopt;
   }
 
-  // Pose of every tracked frame as it was estimated at that frame's time.
+  // Pose of every tracked frame as it was estimated at that frame's time, in the frame of the map
+  // the run began with (FirstMapFrame: frames of a map of its own are left out).
   virtual Trajectory trajectoryAtFrameTime() const = 0;
-  // Every tracked frame relative to its reference keyframe's final pose.
+  // Every tracked frame relative to its reference keyframe's final pose, where that is in the
+  // first map's frame.
   virtual Trajectory trajectoryFinal() const = 0;
+  // What trajectoryAtFrameTime() left out, by map (in order of their first frame).
+  virtual std::vector<OwnMapTrajectory> trajectoriesInOwnFrames() const { return {}; }
   virtual Trajectory keyframeTrajectory() const = 0;
   virtual std::size_t keyFrameCount() const = 0;
   virtual std::size_t mapPointCount() const = 0;
@@ -173,6 +186,7 @@ class TrackingSlam : public SlamSystem {
                       const cv::Mat& depth, const cv::Mat& color = cv::Mat()) override;
   Trajectory trajectoryAtFrameTime() const override;
   Trajectory trajectoryFinal() const override;
+  std::vector<OwnMapTrajectory> trajectoriesInOwnFrames() const override;
   Trajectory keyframeTrajectory() const override;
   std::size_t keyFrameCount() const override;
   std::size_t mapPointCount() const override;
@@ -227,6 +241,7 @@ class TrackingSlam : public SlamSystem {
   Map map_;
   std::unique_ptr<Tracker> tracker_;
   std::unique_ptr<SemanticFrameFilter> semantic_filter_;  // with semantic culling
+  FirstMapFrame first_map_frame_;  // subclasses tell it of merges that join the first map
 
  private:
   SemanticFrame last_semantic_;
