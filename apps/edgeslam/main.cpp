@@ -10,6 +10,7 @@
 #include <string>
 
 #include "commands.h"
+#include "huge_page_heap.h"
 
 namespace edgeslam::cli {
 
@@ -53,6 +54,7 @@ void quietLibraries(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  edgeslam::cli::restartWithHugePageHeap(argv);
   quietLibraries(argc, argv);
   CLI::App app{
       "edgeslam: edge-assisted real-time semantic visual SLAM.\n"

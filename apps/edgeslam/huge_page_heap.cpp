@@ -1,0 +1,57 @@
+#include "huge_page_heap.h"
+
+#include <unistd.h>
+
+#include <cstdlib>
+#include <fstream>
+#include <string>
+
+namespace edgeslam::cli {
+namespace {
+
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+constexpr bool kSanitized = true;
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer) || \
+    __has_feature(memory_sanitizer)
+constexpr bool kSanitized = true;
+#else
+constexpr bool kSanitized = false;
+#endif
+#else
+constexpr bool kSanitized = false;
+#endif
+
+constexpr const char* kTunable = "glibc.malloc.hugetlb";
+
+bool kernelOffersHugePages() {
+  std::ifstream in("/sys/kernel/mm/transparent_hugepage/enabled");
+  std::string modes;
+  std::getline(in, modes);
+  return modes.find("[always]") != std::string::npos ||
+         modes.find("[madvise]") != std::string::npos;
+}
+
+}  // namespace
+
+void restartWithHugePageHeap(char** argv) {
+  if (kSanitized) return;
+  if (const char* off = std::getenv("EDGESLAM_HUGE_PAGES"); off != nullptr && std::string(off) == "0") {
+    return;
+  }
+  const char* existing = std::getenv("GLIBC_TUNABLES");
+  std::string tunables = existing != nullptr ? existing : "";
+  if (tunables.find(kTunable) != std::string::npos) return;  // set: by us or by the user
+  if (!kernelOffersHugePages()) return;
+  tunables += (tunables.empty() ? "" : ":") + std::string(kTunable) + "=1";
+  if (setenv("GLIBC_TUNABLES", tunables.c_str(), 1) != 0) return;
+  execv("/proc/self/exe", argv);
+  // Not restarted (no /proc, say): go on as started, and do not leave the tunable claimed.
+  if (existing != nullptr) {
+    setenv("GLIBC_TUNABLES", existing, 1);
+  } else {
+    unsetenv("GLIBC_TUNABLES");
+  }
+}
+
+}  // namespace edgeslam::cli
