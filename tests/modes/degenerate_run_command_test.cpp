@@ -133,9 +133,9 @@ TEST(DegenerateRun, HighwaySpeedForwardMotionReportsOnlyPosesItCanTrust) {
   const double path_m = pathLength(readKittiPoses(highway / "poses.txt"));
   ASSERT_GT(path_m, 80.0);
 
-  // Lock-step threads: free-running, about 1 run in 8 that tracks the whole stretch loses scale
-  // at frames 35-45 (steps 2-3x too short; ATE 1.3-6.2 m, session 26), a spread issue of its
-  // own (docs/faults.md); this test is about what a degenerate input may report.
+  // Lock-step threads: free-running, about 1 run in 6 tracks the whole stretch but loses scale at
+  // frames 35-45 (steps 2-3x too short; ATE 1.3-6.2 m, 8 of 44 runs in session 26), a spread
+  // issue of its own (docs/faults.md); this test is about what a degenerate input may report.
   const auto m = run(highway, folder / "out", "local --deterministic");
   ASSERT_FALSE(m.empty());
   EXPECT_EQ(m["frames"], 51);
