@@ -36,7 +36,8 @@ bool kernelOffersHugePages() {
 
 void restartWithHugePageHeap(char** argv) {
   if (kSanitized) return;
-  if (const char* off = std::getenv("EDGESLAM_HUGE_PAGES"); off != nullptr && std::string(off) == "0") {
+  if (const char* off = std::getenv("EDGESLAM_HUGE_PAGES");
+      off != nullptr && std::string(off) == "0") {
     return;
   }
   const char* existing = std::getenv("GLIBC_TUNABLES");
