@@ -32,10 +32,29 @@ bool kernelOffersHugePages() {
          modes.find("[madvise]") != std::string::npos;
 }
 
+// The sub-command named on the command line ("" for none): the first word that is neither an
+// option nor the value of the one global option that takes a value.
+std::string subcommand(char** argv) {
+  for (int i = 1; argv[i] != nullptr; ++i) {
+    const std::string word = argv[i];
+    if (word == "--log-level") {
+      if (argv[i + 1] == nullptr) break;
+      ++i;
+    } else if (!word.starts_with("-")) {
+      return word;
+    }
+  }
+  return "";
+}
+
 }  // namespace
 
 void restartWithHugePageHeap(char** argv) {
   if (kSanitized) return;
+  // A restart costs a second start of the binary (~0.25 s of loading its libraries here): worth it
+  // for the commands that hold maps, not for the quick ones.
+  const std::string command = subcommand(argv);
+  if (command != "server" && command != "run" && command != "client" && command != "map") return;
   if (const char* off = std::getenv("EDGESLAM_HUGE_PAGES");
       off != nullptr && std::string(off) == "0") {
     return;
