@@ -3,8 +3,9 @@
 #include <unistd.h>
 
 #include <cstdlib>
-#include <fstream>
 #include <string>
+
+#include "util/transparent_huge_pages.h"
 
 namespace edgeslam::cli {
 namespace {
@@ -23,14 +24,6 @@ constexpr bool kSanitized = false;
 #endif
 
 constexpr const char* kTunable = "glibc.malloc.hugetlb";
-
-bool kernelOffersHugePages() {
-  std::ifstream in("/sys/kernel/mm/transparent_hugepage/enabled");
-  std::string modes;
-  std::getline(in, modes);
-  return modes.find("[always]") != std::string::npos ||
-         modes.find("[madvise]") != std::string::npos;
-}
 
 // The sub-command named on the command line ("" for none): the first word that is neither an
 // option nor the value of the one global option that takes a value.
@@ -62,7 +55,7 @@ void restartWithHugePageHeap(char** argv) {
   const char* existing = std::getenv("GLIBC_TUNABLES");
   std::string tunables = existing != nullptr ? existing : "";
   if (tunables.find(kTunable) != std::string::npos) return;  // set: by us or by the user
-  if (!kernelOffersHugePages()) return;
+  if (!kernelOffersTransparentHugePages()) return;
   tunables += (tunables.empty() ? "" : ":") + std::string(kTunable) + "=1";
   if (setenv("GLIBC_TUNABLES", tunables.c_str(), 1) != 0) return;
   execv("/proc/self/exe", argv);

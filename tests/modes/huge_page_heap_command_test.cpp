@@ -11,17 +11,10 @@
 #include "io/temp_folder.h"
 #include "support/child_process.h"
 #include "support/edgeslam_command.h"
+#include "util/transparent_huge_pages.h"
 
 namespace edgeslam {
 namespace {
-
-bool kernelOffersHugePages() {
-  std::ifstream in("/sys/kernel/mm/transparent_hugepage/enabled");
-  std::string modes;
-  std::getline(in, modes);
-  return modes.find("[always]") != std::string::npos ||
-         modes.find("[madvise]") != std::string::npos;
-}
 
 // The environment of a server started with `huge_pages` ("" = the variable unset), once it
 // listens.
@@ -48,7 +41,8 @@ std::string serverEnvironment(const std::string& huge_pages) {
 }
 
 TEST(HugePageHeap, TheBinaryRunsWithTheTunableUnlessToldNot) {
-  if (!kernelOffersHugePages()) GTEST_SKIP() << "transparent huge pages are off on this host";
+  if (!kernelOffersTransparentHugePages())
+    GTEST_SKIP() << "transparent huge pages are off on this host";
   EXPECT_NE(serverEnvironment("").find("GLIBC_TUNABLES=glibc.malloc.hugetlb=1"), std::string::npos);
   EXPECT_EQ(serverEnvironment("0").find("GLIBC_TUNABLES"), std::string::npos);
 }
