@@ -245,6 +245,7 @@ void RunReport::addModeMetrics() {
     const SemanticCounters& s = counters_.semantic;
     nlohmann::json semantic = {{"enabled", options.semantic},
                                {"keyframes_segmented", s.keyframes_segmented},
+                               {"keyframes_not_segmented", s.keyframes_not_segmented},
                                {"movable_points_erased", s.movable_points_erased},
                                {"frames_with_mask", s.frames_with_mask},
                                {"features_culled", s.features_culled},

@@ -27,6 +27,11 @@ void SemanticFrameFilter::offerMask(std::size_t frame_index, cv::Mat1b labels) {
   {
     MutexLock lock(mutex_);
     ++counters_.masks_received;
+    if (newest_offered_ && *newest_offered_ > frame_index) {
+      ++counters_.masks_superseded;
+      return;
+    }
+    newest_offered_ = frame_index;
     for (const auto& entry : history_) {
       if (entry.first >= frame_index) since.push_back(entry);
     }

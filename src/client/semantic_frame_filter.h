@@ -46,6 +46,9 @@ struct SemanticFilterCounters {
   std::size_t masks_received = 0;
   std::size_t masks_applied = 0;
   std::size_t masks_too_old = 0;  // their keyframe had left the history
+  // A newer keyframe's mask had come first (keyframes are segmented newest first): it serves the
+  // map (its points on people leave), not tracking.
+  std::size_t masks_superseded = 0;
   std::size_t frames_with_mask = 0;
   std::size_t frames_without_mask = 0;  // before the first mask came back
   std::size_t features_culled = 0;
@@ -93,6 +96,7 @@ class SemanticFrameFilter {
   mutable Mutex mutex_;  // guards the fields below
   History history_ GUARDED_BY(mutex_);
   std::optional<CarriedMask> carried_ GUARDED_BY(mutex_);
+  std::optional<std::size_t> newest_offered_ GUARDED_BY(mutex_);  // keyframe frame of the newest
   SemanticFilterCounters counters_ GUARDED_BY(mutex_);
   std::deque<std::size_t> recent_delays_ GUARDED_BY(mutex_);
   std::optional<std::size_t> typical_delay_

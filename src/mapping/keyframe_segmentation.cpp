@@ -11,9 +11,12 @@ KeyFrameSegmentationWorker::KeyFrameSegmentationWorker(std::shared_ptr<Segmenter
                                                        Done done, std::size_t max_queued)
     : segmenter_(std::move(segmenter)),
       done_(std::move(done)),
-      queue_(
-          "keyframe segmentation", [this](KeyFrameSegmentationJob job) { segment(std::move(job)); },
-          {.capacity = std::max<std::size_t>(1, max_queued), .thread_nice = 0, .on_failure = {}}) {
+      queue_("keyframe segmentation",
+             [this](KeyFrameSegmentationJob job) { segment(std::move(job)); },
+             {.capacity = std::max<std::size_t>(1, max_queued),
+              .newest_first = true,
+              .thread_nice = 0,
+              .on_failure = {}}) {
   queue_.start();
 }
 

@@ -252,7 +252,11 @@ MappingBackendCounters MappingBackend::counters() const {
   }
   out.keyframes_segmented = keyframes_segmented_.load();
   out.movable_points_erased = movable_points_erased_.load();
-  if (segmentation_) out.segmentation_ms = segmentation_->counters().segmentation_ms;
+  if (segmentation_) {
+    const KeyFrameSegmentationCounters segmentation = segmentation_->counters();
+    out.segmentation_ms = segmentation.segmentation_ms;
+    out.keyframes_not_segmented = segmentation.skipped;
+  }
   return out;
 }
 

@@ -74,6 +74,7 @@ struct MappingBackendCounters {
   std::uint64_t loops = 0;
   std::uint64_t merges = 0;  // of those, loops that joined two parts of the map
   std::uint64_t keyframes_segmented = 0;
+  std::uint64_t keyframes_not_segmented = 0;  // left the segmentation queue beyond its bound
   std::uint64_t movable_points_erased = 0;
   PercentileSummary segmentation_ms;
 };

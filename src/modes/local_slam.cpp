@@ -93,6 +93,7 @@ SlamCounters LocalSlam::counters() const {
   addClientCounters(out);
   if (backend_->segments()) {
     out.semantic.keyframes_segmented = backend.keyframes_segmented;
+    out.semantic.keyframes_not_segmented = backend.keyframes_not_segmented;
     out.semantic.segmentation_ms = backend.segmentation_ms;
     out.semantic.movable_points_erased = backend.movable_points_erased;
   }

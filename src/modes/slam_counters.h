@@ -34,11 +34,12 @@ struct EdgeExchangeCounters {
 // Semantic culling: keyframes segmented where they are mapped, features culled on the client.
 struct SemanticCounters {
   std::uint64_t keyframes_segmented = 0;
-  std::uint64_t movable_points_erased = 0;  // local mode (the edge erases its own)
-  PercentileSummary segmentation_ms;        // per keyframe, where it ran
-  PercentileSummary client_ms;              // mask transfer and culling per frame
-  std::uint64_t frames_with_mask = 0;       // tracked with a mask transferred from a keyframe's
-  std::uint64_t frames_without_mask = 0;    // tracked before any mask was back
+  std::uint64_t keyframes_not_segmented = 0;  // local mode: skipped by a full queue
+  std::uint64_t movable_points_erased = 0;    // local mode (the edge erases its own)
+  PercentileSummary segmentation_ms;          // per keyframe, where it ran
+  PercentileSummary client_ms;                // mask transfer and culling per frame
+  std::uint64_t frames_with_mask = 0;         // tracked with a mask transferred from a keyframe's
+  std::uint64_t frames_without_mask = 0;      // tracked before any mask was back
   std::uint64_t features_culled = 0;
   // Frames by the age of their mask (frames since its keyframe): [age] up to 63, [64] beyond.
   std::array<std::uint64_t, 65> mask_age{};

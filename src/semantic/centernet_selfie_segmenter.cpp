@@ -54,6 +54,16 @@ CenterNetSelfieSegmenter::CenterNetSelfieSegmenter(const SegmenterOptions& optio
   }
   detector_options_.input_size = options.detector_input_size;
   for (int id : detector_options_.classes) cocoClassName(id);  // throws for a bad id
+  warmUp();
+}
+
+void CenterNetSelfieSegmenter::warmUp() {
+  // OpenCV DNN sets each network up on its first forward pass (a few times a later pass): here,
+  // before the first keyframe, rather than on it, where it made the first mask of a run ~4x later.
+  const cv::Mat blank(options_.detector_input_size, options_.detector_input_size, CV_8UC3,
+                      cv::Scalar::all(0));
+  detector_.detect(blank, detector_options_);
+  person_masks_.probability(blank, cv::Rect(0, 0, blank.cols, blank.rows));
 }
 
 void CenterNetSelfieSegmenter::setNmsThreshold(float nm) {

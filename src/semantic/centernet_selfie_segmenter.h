@@ -27,6 +27,7 @@ class CenterNetSelfieSegmenter final : public Segmenter {
   static constexpr const char* kPersonMaskFile = "mediapipe_selfie_256.onnx";
 
  private:
+  void warmUp();
   SegmentedInstance maskInstance(const cv::Mat& bgr, const Detection& detection);
 
   SegmenterOptions options_;

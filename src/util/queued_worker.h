@@ -25,6 +25,8 @@ namespace edgeslam {
 struct QueuedWorkerOptions {
   // 0: unbounded. Otherwise a push beyond it drops the oldest waiting item (counted in dropped()).
   std::size_t capacity = 0;
+  // Take the newest waiting item first (the older ones wait until the worker has time).
+  bool newest_first = false;
   // Nice increment for the thread (util/thread_priority.h); 0 leaves it as it is.
   int thread_nice = 0;
   WorkerThread::FailureHandler on_failure;
@@ -159,8 +161,7 @@ class QueuedWorker {
         lock.wait(wake_,
                   [this]() REQUIRES(mutex_) { return stopping_ || (!paused_ && !queue_.empty()); });
         if (stopping_) return;
-        item.emplace(std::move(queue_.front()));
-        queue_.pop_front();
+        item.emplace(popNext());
         busy_ = true;
         give_way_ = false;
       }
@@ -171,9 +172,19 @@ class QueuedWorker {
   std::optional<Item> takeNow() {
     MutexLock lock(mutex_);
     if (queue_.empty()) return std::nullopt;
-    std::optional<Item> item(std::move(queue_.front()));
-    queue_.pop_front();
+    std::optional<Item> item(popNext());
     give_way_ = false;
+    return item;
+  }
+
+  Item popNext() REQUIRES(mutex_) {
+    if (options_.newest_first) {
+      Item item(std::move(queue_.back()));
+      queue_.pop_back();
+      return item;
+    }
+    Item item(std::move(queue_.front()));
+    queue_.pop_front();
     return item;
   }
 

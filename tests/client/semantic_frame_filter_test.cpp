@@ -89,6 +89,21 @@ TEST(SemanticFrameFilter, AnEmptyKeyframeMaskClearsTheOldOne) {
   EXPECT_EQ(cv::countNonZero(out.mask), 0);
 }
 
+TEST(SemanticFrameFilter, AnOlderKeyframesMaskAfterANewerOneIsLeftOut) {
+  // Keyframes are segmented newest first: the mask of keyframe 1 arrives after keyframe 3's.
+  const cv::Rect newer(200, 150, 120, 160);
+  const cv::Rect older(20, 20, 100, 100);
+  SemanticFrameFilter filter(test::syntheticCamera());
+  for (std::size_t i = 0; i < 4; ++i) filter.filter(i, lattice(newer, {}, {}));
+  filter.offerMask(3, labelsWith(newer));
+  filter.offerMask(1, labelsWith(older));
+  const SemanticFrame out = filter.filter(4, lattice(newer, {}, {}));
+  EXPECT_EQ(out.mask_source_frame, std::optional<std::size_t>(3));
+  EXPECT_EQ(cv::countNonZero(out.mask(older)), 0);
+  EXPECT_EQ(filter.counters().masks_superseded, 1u);
+  EXPECT_EQ(filter.counters().masks_applied, 1u);
+}
+
 TEST(SemanticFrameFilter, RefusesMisSizedMasksAndCountsMasksPastTheHistory) {
   SemanticFilterOptions options;
   options.history_frames = 5;

@@ -142,6 +142,17 @@ TEST(QueuedWorker, AFullQueueDropsItsOldestItemAndCountsIt) {
   EXPECT_EQ(record.seenOn(), std::vector<std::thread::id>(2, std::this_thread::get_id()));
 }
 
+TEST(QueuedWorker, NewestFirstTakesTheLatestItemAndDropsTheOldestBeyondItsBound) {
+  Record record;
+  QueuedWorker<int> worker(
+      "newest first", [&](int item) { record.add(item); },
+      {.capacity = 3, .newest_first = true, .thread_nice = 0, .on_failure = {}});
+  for (int i = 1; i <= 5; ++i) EXPECT_TRUE(worker.push(i));
+  EXPECT_EQ(worker.dropped(), 2u);
+  worker.processAll();
+  EXPECT_EQ(record.seen(), (std::vector<int>{5, 4, 3}));
+}
+
 TEST(QueuedWorker, PauseHoldsItemsUntilResume) {
   Record record;
   QueuedWorker<int> worker("pausable", [&](int item) { record.add(item); });
