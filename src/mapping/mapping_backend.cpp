@@ -207,7 +207,8 @@ void MappingBackend::onSegmented(KeyFrameSegmentationResult result) {
       erased = eraseMovablePoints(map_, *keyframe, result.labels, movable_point_erode_px_);
     }
   }
-  ++keyframes_segmented_;
+  // A frame segmented before the map existed (kInvalidId) serves tracking only.
+  if (result.keyframe != kInvalidId) ++keyframes_segmented_;
   movable_points_erased_ += erased;
   if (hooks_.keyframe_segmented) hooks_.keyframe_segmented(std::move(result));
 }

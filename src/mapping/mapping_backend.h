@@ -103,7 +103,8 @@ class MappingBackend : public KeyFrameSink {
   std::size_t lastOptimizedFrame() const override;
   void onMapReset() override;
 
-  // Queues a keyframe's image for segmentation (waits for it, unthreaded). Needs a segmenter.
+  // Queues a keyframe's image for segmentation (waits for it, unthreaded); job.keyframe kInvalidId:
+  // a frame before the map exists (its mask serves tracking only). Needs a segmenter.
   void segment(KeyFrameSegmentationJob job);
   bool segments() const { return segmentation_ != nullptr; }
   // Box NMS threshold of the segmenter (paper Table I's nm), from the next keyframe on.

@@ -31,10 +31,14 @@ class LocalSlam : public TrackingSlam {
   void afterFrame() override;
   void afterTracking(const TrackResult& result, std::size_t frame_index,
                      const cv::Mat& image) override;
+  // Before a map exists no keyframe is made, so frames are segmented every refresh interval: a
+  // monocular map is then begun on frames whose people are masked.
+  void segmentBeforeTheMap(std::size_t frame_index, const cv::Mat& image);
   void refineIntrinsicsOfTheMap();
 
   std::unique_ptr<MappingBackend> backend_;
   std::optional<MapIntrinsicsRefinement> intrinsics_refinement_;
+  std::size_t next_frame_to_segment_before_the_map_ = 0;
 };
 
 }  // namespace edgeslam
