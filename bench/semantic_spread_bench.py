@@ -2,17 +2,19 @@
 """Semantic culling over a spread of generated dynamic sequences (issue 21): N sequences made by
 `edgeslam synth-dynamic` from 7-Scenes redkitchen, each with its own seed, frame range, number of
 people (1-3) and their size (target coverage 10-38 %; the walks' speeds come from the seed),
-alternately RGB-D and monocular. Each is run three times in local mode: on the source frames
-(static), with semantic culling off, and on. Reported per sequence and as a distribution (median,
+alternately RGB-D and monocular. Each is run three times, in local mode or (`--mode edge`) as a
+server and a client on a core each, behind an emulated link (`--link`) with or without the
+client's adaptation: on the source frames (static), with semantic culling off, and on. Reported per sequence and as a distribution (median,
 worst): transferred-mask IoU on non-keyframes and on keyframes, culled-feature precision and
 recall, ATE of the run against the static run (semantic on and off), mask age.
 
 Two sets with disjoint seeds: `tuning` (seeds 1000+i: for trying changes) and `report` (seeds
 2000+i: for the figures in docs; not to tune on). The tables go into docs/dynamic_benchmark.md
-between <!-- semantic-spread-SET-PACING --> markers.
+between <!-- semantic-spread-SET-PACING[-edge-LINK] --> markers.
 
   bench/semantic_spread_bench.py [--set report] [--count 20] [--length 240]
-                                 [--pacing realtime|fast] [--build-dir build] [--no-docs]
+                                 [--pacing realtime|fast] [--mode local|edge] [--link NAME]
+                                 [--adapt on|off] [--build-dir build] [--no-docs]
 """
 import argparse
 import json
@@ -93,6 +95,13 @@ def main():
     parser.add_argument("--count", type=int, default=20)
     parser.add_argument("--length", type=int, default=240, help="frames per sequence")
     parser.add_argument("--pacing", choices=["realtime", "fast"], default="realtime")
+    parser.add_argument("--mode", choices=["local", "edge"], default="local",
+                        help="edge: `edgeslam server` on core 1, `edgeslam client` on core 0")
+    parser.add_argument("--link", default="none",
+                        help="edge mode: emulated link of the client (none, wifi5, wifi24, lte, "
+                             "lte-congested)")
+    parser.add_argument("--adapt", choices=["on", "off"], default="on",
+                        help="edge mode: the client's adaptation to the link (paper Table I)")
     parser.add_argument("--only", help="comma-separated sequence numbers to run (for trying)")
     parser.add_argument("--no-docs", action="store_true")
     args = parser.parse_args()
@@ -101,6 +110,13 @@ def main():
     os.makedirs(args.work, exist_ok=True)
     source = os.path.join(args.shared, SOURCE)
     pacing = "--" + args.pacing
+    if args.mode == "local" and args.link != "none":
+        parser.error("--link needs --mode edge")
+    mode_args = [] if args.mode == "local" else ["--link", args.link, "--adapt", args.adapt]
+    setting = "local mode" if args.mode == "local" else (
+        f"edge mode (server and client on a core each), link `{args.link}`, adaptation "
+        f"{args.adapt}")
+    suffix = "" if args.mode == "local" else f"-edge-{args.link}"
     sequences = plan(args.set, args.count, args.length)
     if args.only:
         wanted = {int(v) for v in args.only.split(",")}
@@ -110,10 +126,10 @@ def main():
     for seq in sequences:
         dataset = generate(binary, args.shared, args.work, seq)
         sensor = seq["sensor"]
-        static = run_once(binary, source, sensor, "local", "off", 0, ["--frames", seq["frames"]],
-                          pacing)
-        off = run_once(binary, dataset, sensor, "local", "off", 0, [], pacing)
-        on = run_once(binary, dataset, sensor, "local", "on", 0, [], pacing)
+        static = run_once(binary, source, sensor, args.mode, "off", 0,
+                          ["--frames", seq["frames"]] + mode_args, pacing)
+        off = run_once(binary, dataset, sensor, args.mode, "off", 0, mode_args, pacing)
+        on = run_once(binary, dataset, sensor, args.mode, "on", 0, mode_args, pacing)
         age = semantic(on, "mask_age_frames") or {}
         row = dict(seq)
         row.update({
@@ -142,8 +158,9 @@ def main():
 
     lines = [
         f"Set `{args.set}` ({len(rows)} sequences of {args.length} frames, seeds "
-        f"{SET_SEEDS[args.set]}+), `--{args.pacing}`, local mode, one run per cell; "
-        f"`bench/semantic_spread_bench.py --set {args.set} --pacing {args.pacing}`, "
+        f"{SET_SEEDS[args.set]}+), `--{args.pacing}`, {setting}, one run per cell; "
+        f"`bench/semantic_spread_bench.py --set {args.set} --pacing {args.pacing}"
+        f"{'' if args.mode == 'local' else f' --mode edge --link {args.link} --adapt {args.adapt}'}`, "
         f"{elapsed / 60:.0f} min, {time.strftime('%Y-%m-%d')}.",
         "",
         "| sequence | sensor | frames | people | coverage median | walk m/s | mask IoU (non-kf / kf) "
@@ -183,19 +200,19 @@ def main():
     table = "\n".join(lines)
     print()
     print(table)
-    with open(os.path.join(args.work, f"{args.set}-{args.pacing}.json"), "w") as f:
+    with open(os.path.join(args.work, f"{args.set}-{args.pacing}{suffix}.json"), "w") as f:
         json.dump(rows, f, indent=1)
     if not args.no_docs and not args.only:
         path = os.path.join(ROOT, "docs", "dynamic_benchmark.md")
         with open(path) as f:
             text = f.read()
-        marker = f"semantic-spread-{args.set}-{args.pacing}"
+        marker = f"semantic-spread-{args.set}-{args.pacing}{suffix}"
         block = f"<!-- {marker} -->\n{table}\n<!-- /{marker} -->"
         if f"<!-- {marker} -->" in text:
             text = re.sub(rf"<!-- {marker} -->.*?<!-- /{marker} -->", lambda _: block, text,
                           flags=re.S)
         else:
-            text += f"\n### {args.set} set, --{args.pacing}\n\n{block}\n"
+            text += f"\n### {args.set} set, --{args.pacing}, {setting}\n\n{block}\n"
         with open(path, "w") as f:
             f.write(text)
         print(f"wrote {path} ({marker})")
