@@ -3,7 +3,7 @@
 // network's inference (paper Sec. IV-B: only keyframes are segmented). The newest keyframe is
 // segmented first (its mask serves tracking best); the older ones wait for a quiet moment rather
 // than being skipped, since a keyframe never segmented keeps the points it made on people in the
-// map for good (the first keyframes of an RGB-D run come one per frame, before any mask: 6 of 10
+// map for good (the first keyframes of an RGB-D run come one per frame, before any mask: 5-7 of 10
 // were skipped, and the ATE at --realtime was 1.3-1.9x the static run's). Beyond the bound the
 // oldest waiting keyframe is skipped.
 #include <atomic>

@@ -42,25 +42,25 @@ LocalSlam::~LocalSlam() {
   backend_->stop();
 }
 
-void LocalSlam::segmentBeforeTheMap(std::size_t frame_index, const cv::Mat& image) {
-  if (frame_index < next_frame_to_segment_before_the_map_) return;
-  const int refresh = tracker_->keyframeParameters().segmentation_refresh;
-  next_frame_to_segment_before_the_map_ =
-      frame_index + static_cast<std::size_t>(std::max(1, refresh));
-  backend_->segment({kInvalidId, frame_index, image.clone(),
-                     cv::Size(camera_.width(), camera_.height()), options_.keyframe_image_reduce});
-  waitForBackend([this] { backend_->waitUntilSegmented(); });
-}
-
 void LocalSlam::afterTracking(const TrackResult& result, std::size_t frame_index,
                               const cv::Mat& image) {
   if (!backend_->segments()) return;
   if (result.state == TrackingState::kNotInitialized) {
-    segmentBeforeTheMap(frame_index, image);
-    return;
+    // No keyframe before the map exists: a frame every refresh interval is segmented instead, so
+    // that a monocular map is begun on frames whose people are masked.
+    if (frame_index < next_frame_to_segment_before_the_map_) return;
+    const int refresh = tracker_->keyframeParameters().segmentation_refresh;
+    next_frame_to_segment_before_the_map_ =
+        frame_index + static_cast<std::size_t>(std::max(1, refresh));
+    segmentAndWaitWhenFast(kInvalidId, frame_index, image);
+  } else if (result.new_keyframe && result.keyframe != kInvalidId) {
+    segmentAndWaitWhenFast(result.keyframe, frame_index, image);
   }
-  if (!result.new_keyframe || result.keyframe == kInvalidId) return;
-  backend_->segment({result.keyframe, frame_index, image.clone(),
+}
+
+void LocalSlam::segmentAndWaitWhenFast(KeyFrameId keyframe, std::size_t frame_index,
+                                       const cv::Mat& image) {
+  backend_->segment({keyframe, frame_index, image.clone(),
                      cv::Size(camera_.width(), camera_.height()), options_.keyframe_image_reduce});
   // Frames fed back to back (--fast) would otherwise get a keyframe's mask as many frames late as
   // they are faster than segmentation (8-10 frames, where a camera at 30 fps sees it 2 frames

@@ -31,9 +31,8 @@ class LocalSlam : public TrackingSlam {
   void afterFrame() override;
   void afterTracking(const TrackResult& result, std::size_t frame_index,
                      const cv::Mat& image) override;
-  // Before a map exists no keyframe is made, so frames are segmented every refresh interval: a
-  // monocular map is then begun on frames whose people are masked.
-  void segmentBeforeTheMap(std::size_t frame_index, const cv::Mat& image);
+  // keyframe kInvalidId: a frame before the map exists (its mask serves tracking only).
+  void segmentAndWaitWhenFast(KeyFrameId keyframe, std::size_t frame_index, const cv::Mat& image);
   void refineIntrinsicsOfTheMap();
 
   std::unique_ptr<MappingBackend> backend_;
