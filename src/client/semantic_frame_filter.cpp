@@ -32,6 +32,12 @@ void SemanticFrameFilter::offerMask(std::size_t frame_index, cv::Mat1b labels) {
       return;
     }
     newest_offered_ = frame_index;
+    if (history_.empty() || frame_index > history_.back().first) {
+      // The frame's own mask, made before the frame is filtered: applied as it is then.
+      noteDelay(0);
+      mask_ahead_ = MaskAhead{frame_index, std::move(labels)};
+      return;
+    }
     for (const auto& entry : history_) {
       if (entry.first >= frame_index) since.push_back(entry);
     }
@@ -90,15 +96,27 @@ SemanticFrame SemanticFrameFilter::filter(std::size_t frame_index,
   out.all = all;
   out.kept = all;
   takeCarriedMask();
-  if (propagator_ && frame_index > last_frame_) {
+  std::optional<MaskAhead> ahead;
+  {
+    MutexLock lock(mutex_);
+    if (mask_ahead_ && mask_ahead_->frame <= frame_index) ahead.swap(mask_ahead_);
+  }
+  if (ahead && ahead->frame == frame_index) {
+    out.mask = ahead->labels > 0;
+    out.mask_source_frame = frame_index;
+    propagator_ = std::make_unique<MaskPropagator>(options_.propagation);
+    propagator_->setReference(std::move(ahead->labels), all);
+    source_frame_ = frame_index;
+    last_frame_ = frame_index;
+    cull(out);
+    MutexLock lock(mutex_);
+    ++counters_.masks_applied;
+  } else if (propagator_ && frame_index > last_frame_) {
     MaskTransferResult transferred = propagator_->propagate(*all, frame_index - last_frame_);
     last_frame_ = frame_index;
     out.mask = std::move(transferred.mask);
     out.mask_source_frame = source_frame_;
-    const std::vector<int> keep =
-        indicesOutsideMask(all->keypoints, out.mask, options_.cull_margin_px);
-    out.culled = static_cast<int>(all->size() - keep.size());
-    if (out.culled > 0) out.kept = selectFeatures(*all, keep, camera_);
+    cull(out);
   }
   out.elapsed_ms = timer.elapsedMs();
   MutexLock lock(mutex_);
@@ -112,6 +130,13 @@ SemanticFrame SemanticFrameFilter::filter(std::size_t frame_index,
   }
   counters_.features_culled += static_cast<std::size_t>(out.culled);
   return out;
+}
+
+void SemanticFrameFilter::cull(SemanticFrame& frame) const {
+  const std::vector<int> keep =
+      indicesOutsideMask(frame.all->keypoints, frame.mask, options_.cull_margin_px);
+  frame.culled = static_cast<int>(frame.all->size() - keep.size());
+  if (frame.culled > 0) frame.kept = selectFeatures(*frame.all, keep, camera_);
 }
 
 void SemanticFrameFilter::noteDelay(std::size_t frames) {

@@ -61,7 +61,8 @@ class SemanticFrameFilter {
   explicit SemanticFrameFilter(const PinholeCamera& camera, SemanticFilterOptions options = {});
 
   // The label image (full image size) of the keyframe made from frame `frame_index`. Called from
-  // the link's or the segmenter's thread (thread-safe); does the catch-up work there.
+  // the link's or the segmenter's thread (thread-safe); does the catch-up work there. The mask of
+  // a frame not filtered yet (segmented before its features are culled) is kept for it.
   void offerMask(std::size_t frame_index, cv::Mat1b labels);
 
   // On the tracking thread, once per frame in order.
@@ -82,7 +83,14 @@ class SemanticFrameFilter {
   };
   using History = std::deque<std::pair<std::size_t, std::shared_ptr<const FrameFeatures>>>;
 
+  // A frame's own mask, offered before the frame was filtered.
+  struct MaskAhead {
+    std::size_t frame = 0;
+    cv::Mat1b labels;
+  };
+
   void takeCarriedMask();
+  void cull(SemanticFrame& frame) const;  // the features of frame.all outside frame.mask
   void noteDelay(std::size_t frames) REQUIRES(mutex_);  // on the delivering thread
 
   PinholeCamera camera_;
@@ -96,6 +104,7 @@ class SemanticFrameFilter {
   mutable Mutex mutex_;  // guards the fields below
   History history_ GUARDED_BY(mutex_);
   std::optional<CarriedMask> carried_ GUARDED_BY(mutex_);
+  std::optional<MaskAhead> mask_ahead_ GUARDED_BY(mutex_);
   std::optional<std::size_t> newest_offered_ GUARDED_BY(mutex_);  // keyframe frame of the newest
   SemanticFilterCounters counters_ GUARDED_BY(mutex_);
   std::deque<std::size_t> recent_delays_ GUARDED_BY(mutex_);

@@ -29,6 +29,7 @@ class LocalSlam : public TrackingSlam {
 
  private:
   void afterFrame() override;
+  void beforeCulling(std::size_t frame_index, const cv::Mat& image) override;
   void afterTracking(const TrackResult& result, std::size_t frame_index,
                      const cv::Mat& image) override;
   // keyframe kInvalidId: a frame before the map exists (its mask serves tracking only).
@@ -38,6 +39,7 @@ class LocalSlam : public TrackingSlam {
   std::unique_ptr<MappingBackend> backend_;
   std::optional<MapIntrinsicsRefinement> intrinsics_refinement_;
   std::size_t next_frame_to_segment_before_the_map_ = 0;
+  bool first_frame_mask_awaited_ = false;
 };
 
 }  // namespace edgeslam

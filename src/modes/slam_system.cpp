@@ -107,7 +107,9 @@ TrackResult TrackingSlam::process(std::size_t frame_index, double timestamp, con
   Stopwatch stage;
   std::shared_ptr<const FrameFeatures> features =
       buildFrameFeatures(gray, used_depth, camera_, extractor_, options_.depth);
+  const cv::Mat& image = color.empty() ? gray : color;
   if (semantic_filter_) {
+    beforeCulling(frame_index, image);
     last_semantic_ = semantic_filter_->filter(frame_index, std::move(features));
     semantic_ms_.add(last_semantic_.elapsed_ms);
     features = last_semantic_.kept;
@@ -120,7 +122,6 @@ TrackResult TrackingSlam::process(std::size_t frame_index, double timestamp, con
     tracker_->keyframeParameters().segmentation_refresh = segmentationRefreshFrames(
         options_.segmentation_refresh, semantic_filter_->typicalMaskDelayFrames());
   }
-  const cv::Mat& image = color.empty() ? gray : color;
   beforeTracking(frame_index, image);
   stage = Stopwatch();
   TrackResult result = tracker_->track(frame_index, timestamp, std::move(features));

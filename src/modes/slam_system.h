@@ -221,6 +221,9 @@ class TrackingSlam : public SlamSystem {
   // Offline pacing (options_.wait_for_backend): blocks on `wait`, counted as a wait for the back
   // end; nothing otherwise.
   void waitForBackend(const std::function<void()>& wait);
+  // With semantic culling, before the frame's features are culled: a mode may segment the frame
+  // first, so that its own mask is the one applied.
+  virtual void beforeCulling(std::size_t /*frame_index*/, const cv::Mat& /*image*/) {}
   // Before tracking a frame whose image is `image` (colour when given, else grey).
   virtual void beforeTracking(std::size_t /*frame_index*/, const cv::Mat& /*image*/) {}
   virtual void afterFrame() {}

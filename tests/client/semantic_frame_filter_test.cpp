@@ -104,6 +104,31 @@ TEST(SemanticFrameFilter, AnOlderKeyframesMaskAfterANewerOneIsLeftOut) {
   EXPECT_EQ(filter.counters().masks_applied, 1u);
 }
 
+TEST(SemanticFrameFilter, AFramesOwnMaskOfferedBeforeItIsFilteredIsAppliedToItAndCarriedOn) {
+  // The first frame of a map with depth is segmented before its features are culled.
+  const cv::Rect object(200, 150, 120, 160);
+  SemanticFilterOptions options;
+  options.cull_margin_px = 0;
+  SemanticFrameFilter filter(test::syntheticCamera(), options);
+  filter.offerMask(0, labelsWith(object));
+  const auto frame0 = lattice(object, {}, {});
+  const SemanticFrame first = filter.filter(0, frame0);
+  ASSERT_EQ(first.mask_source_frame, std::optional<std::size_t>(0));
+  int on_object = 0;
+  for (const cv::KeyPoint& kp : frame0->keypoints) on_object += object.contains(kp.pt);
+  ASSERT_GT(on_object, 0);
+  EXPECT_EQ(first.culled, on_object);
+  EXPECT_EQ(filter.typicalMaskDelayFrames(), std::optional<std::size_t>(0));
+  EXPECT_EQ(filter.counters().masks_too_old, 0u);
+  // The next frame gets it transferred; the keyframe's own later mask of the same frame adds
+  // nothing.
+  filter.offerMask(0, labelsWith(object));
+  const SemanticFrame next = filter.filter(1, lattice(object, {4, 2}, {1, 0}));
+  EXPECT_EQ(next.mask_source_frame, std::optional<std::size_t>(0));
+  EXPECT_GT(next.culled, 0);
+  EXPECT_EQ(filter.counters().masks_applied, 1u);
+}
+
 TEST(SemanticFrameFilter, RefusesMisSizedMasksAndCountsMasksPastTheHistory) {
   SemanticFilterOptions options;
   options.history_frames = 5;
