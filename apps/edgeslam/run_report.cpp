@@ -250,8 +250,9 @@ void RunReport::addModeMetrics() {
                                {"frames_with_mask", s.frames_with_mask},
                                {"features_culled", s.features_culled},
                                {"client_ms", toJson(s.client_ms)}};
-    // Keyframes are segmented after they are tracked, so every tracked frame's mask is one
-    // transferred from an earlier keyframe (or there is none yet).
+    // Keyframes are segmented after they are tracked, so a tracked frame's mask is one transferred
+    // from an earlier keyframe (or there is none yet); only the first frame of a map with depth
+    // in local mode waits for its own (mask age 0).
     semantic["mask_source"] = {{"segmented_keyframes", s.keyframes_segmented},
                                {"transferred", s.frames_with_mask},
                                {"none", s.frames_without_mask}};

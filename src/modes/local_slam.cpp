@@ -48,8 +48,8 @@ void LocalSlam::beforeCulling(std::size_t frame_index, const cv::Mat& image) {
   // tracked against them before any mask is back (report-10: the path over frames 0-19 came out
   // 5-7x the true one). So that frame waits for its own mask, whatever the pacing: a camera
   // started ~60 ms late.
-  if (first_frame_mask_awaited_ || options_.sensor == Sensor::kMonocular ||
-      !backend_->segments() || tracker_->state() != TrackingState::kNotInitialized) {
+  if (first_frame_mask_awaited_ || options_.sensor == Sensor::kMonocular || !backend_->segments() ||
+      tracker_->state() != TrackingState::kNotInitialized) {
     return;
   }
   first_frame_mask_awaited_ = true;
