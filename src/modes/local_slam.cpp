@@ -53,8 +53,7 @@ void LocalSlam::beforeCulling(std::size_t frame_index, const cv::Mat& image) {
     return;
   }
   first_frame_mask_awaited_ = true;
-  backend_->segment({kInvalidId, frame_index, image.clone(),
-                     cv::Size(camera_.width(), camera_.height()), options_.keyframe_image_reduce});
+  submitSegmentation(kInvalidId, frame_index, image);
   backend_->waitUntilSegmented();
 }
 
@@ -74,10 +73,15 @@ void LocalSlam::afterTracking(const TrackResult& result, std::size_t frame_index
   }
 }
 
-void LocalSlam::segmentAndWaitWhenFast(KeyFrameId keyframe, std::size_t frame_index,
-                                       const cv::Mat& image) {
+void LocalSlam::submitSegmentation(KeyFrameId keyframe, std::size_t frame_index,
+                                   const cv::Mat& image) {
   backend_->segment({keyframe, frame_index, image.clone(),
                      cv::Size(camera_.width(), camera_.height()), options_.keyframe_image_reduce});
+}
+
+void LocalSlam::segmentAndWaitWhenFast(KeyFrameId keyframe, std::size_t frame_index,
+                                       const cv::Mat& image) {
+  submitSegmentation(keyframe, frame_index, image);
   // Frames fed back to back (--fast) would otherwise get a keyframe's mask as many frames late as
   // they are faster than segmentation (8-10 frames, where a camera at 30 fps sees it 2 frames
   // late), and the mask transfer would pay for a speed that is the host's, not the camera's. So

@@ -33,6 +33,7 @@ class LocalSlam : public TrackingSlam {
   void afterTracking(const TrackResult& result, std::size_t frame_index,
                      const cv::Mat& image) override;
   // keyframe kInvalidId: a frame before the map exists (its mask serves tracking only).
+  void submitSegmentation(KeyFrameId keyframe, std::size_t frame_index, const cv::Mat& image);
   void segmentAndWaitWhenFast(KeyFrameId keyframe, std::size_t frame_index, const cv::Mat& image);
   void refineIntrinsicsOfTheMap();
 
