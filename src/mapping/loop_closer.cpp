@@ -195,10 +195,11 @@ void LoopCloser::closeLoop(const VerifiedLoop& loop) {
   if (event.keyframes_merged > 0) {
     spdlog::info(
         "maps merged: keyframe {} (frame {}) -> keyframe {} (frame {}): {} keyframes and {} "
-        "points moved onto the other part of the map (scale {:.3f})",
+        "points moved onto the other part of the map (scale {:.3f}{})",
         event.current, event.current_frame, event.loop, event.loop_frame,
         corrected.merged_keyframes_moved, corrected.merged_points_moved,
-        corrected.merge.world.scale());
+        corrected.merge.world.scale(),
+        loop.scale_from_ranges ? ", from the points' ranges: the views meet at one place" : "");
   }
   spdlog::info(
       "loop closed: keyframe {} (frame {}) -> keyframe {} (frame {}): {} Sim3 inliers, {} points "

@@ -199,6 +199,9 @@ LoopVerification verifyLoopCandidates(KeyFrame* current, const std::vector<KeyFr
     Sim3RefinementOptions refine;
     refine.fix_scale = options.fix_scale;
     refine.min_inliers = options.min_sim3_inliers;
+    if (!options.fix_scale) {
+      refine.scale_from_ranges_below_baseline = options.scale_from_ranges_below_baseline;
+    }
     const Sim3RefinementResult refined =
         refineSim3(estimate.cam1_from_cam2, set.matches, projection, projection, refine);
     if (!refined.success || refined.inliers < options.min_sim3_inliers) {
@@ -216,6 +219,7 @@ LoopVerification verifyLoopCandidates(KeyFrame* current, const std::vector<KeyFr
     loop.S_cw = refined.S_12 * Sim3d(candidate->pose());
     loop.bow_matches = bow_count;
     loop.sim3_inliers = refined.inliers;
+    loop.scale_from_ranges = refined.scale_from_ranges;
     loop.loop_keyframes.push_back(candidate);
     for (const auto& [kf, weight] : candidate->connections()) {
       if (!kf->isBad()) loop.loop_keyframes.push_back(kf);

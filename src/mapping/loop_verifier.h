@@ -31,6 +31,11 @@ struct LoopVerifierOptions {
   int min_ransac_inliers = 15;
   int min_sim3_inliers = 20;
   int min_projected_matches = 40;
+  // Monocular: camera centres closer than this fraction of the points' median range leave the
+  // scale to the points' ranges (optimize/sim3_optimizer.h). Two clients passing one place meet
+  // at 0.000-0.002 (the same frame) and 0.035-0.13 (frames apart), where reprojection agreed with
+  // the ranges within 2 %.
+  double scale_from_ranges_below_baseline = 0.02;
   float guided_radius = 7.5f;      // px at level 0, for the mutual Sim(3) search
   float projection_radius = 10.f;  // px at level 0, for the neighbourhood projection
   BowMatchOptions bow;
@@ -43,6 +48,7 @@ struct VerifiedLoop {
   Sim3d S_cw;           // the current keyframe's pose made consistent with the loop side of the map
   int bow_matches = 0;  // over the candidate's window
   int sim3_inliers = 0;
+  bool scale_from_ranges = false;  // monocular views at one place: see the options
   int matched_points = 0;
   // One entry per keypoint of the current keyframe: the loop-side point seen there, or nullptr.
   std::vector<MapPoint*> matched;

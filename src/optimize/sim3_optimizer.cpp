@@ -8,9 +8,11 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
+#include "geometry/sim3_scale.h"
 #include "optimize/reprojection_error.h"
 #include "optimize/sim3_parameters.h"
 
@@ -92,9 +94,20 @@ Sim3RefinementResult refineSim3(const Sim3d& initial_S_12, std::span<const Sim3M
   }
 
   Sim3RefinementResult result;
-  result.S_12 = initial_S_12;
+  Sim3d start = initial_S_12;
+  bool fix_scale = options.fix_scale;
+  if (!fix_scale && options.scale_from_ranges_below_baseline > 0.0) {
+    const std::optional<double> baseline = cameraBaselineOverRange(start, matches);
+    const std::optional<double> scale = scaleFromRanges(start, matches);
+    if (baseline && scale && *baseline<options.scale_from_ranges_below_baseline&& * scale> 0.0) {
+      start = Sim3d(*scale, start.rotation(), start.translation());
+      fix_scale = true;
+      result.scale_from_ranges = true;
+    }
+  }
+  result.S_12 = start;
   result.outliers = std::vector<bool>(matches.size(), false);
-  Sim3Blocks blocks = Sim3Blocks::from(initial_S_12);
+  Sim3Blocks blocks = Sim3Blocks::from(start);
 
   // Marks outliers at the current estimate; returns the inlier count.
   const auto classify = [&]() {
@@ -129,7 +142,7 @@ Sim3RefinementResult refineSim3(const Sim3d& initial_S_12, std::span<const Sim3M
     }
     if (problem.NumResidualBlocks() == 0) return;
     problem.SetManifold(blocks.rotation.data(), &quaternion_manifold);
-    if (options.fix_scale) problem.SetParameterBlockConstant(&blocks.log_scale);
+    if (fix_scale) problem.SetParameterBlockConstant(&blocks.log_scale);
     ceres::Solver::Options solver_options;
     solver_options.linear_solver_type = ceres::DENSE_QR;
     solver_options.max_num_iterations = iterations;

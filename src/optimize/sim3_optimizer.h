@@ -17,6 +17,10 @@ struct Sim3RefinementOptions {
   int second_pass_iterations = 10;
   double chi2_threshold = 10.0;  // per image, on error^2 / sigma^2
   bool fix_scale = false;        // stereo / RGB-D: keep the initial scale
+  // Two monocular maps: where the camera centres are closer than this fraction of the points'
+  // median range, reprojection does not see the scale (geometry/sim3_scale.h). The scale is then
+  // taken from the points' ranges and held while rotation and translation are refined. 0: never.
+  double scale_from_ranges_below_baseline = 0.0;
   // Below this many inliers after the outlier pass the refinement is abandoned (success = false).
   int min_inliers = 10;
 };
@@ -27,6 +31,7 @@ struct Sim3RefinementResult {
   std::vector<bool> outliers;  // one per match
   int inliers = 0;
   int iterations = 0;
+  bool scale_from_ranges = false;  // the scale was held at the points' ranges (see the options)
 };
 
 // Throws std::invalid_argument for bad cameras, non-finite matches or non-positive sigmas.

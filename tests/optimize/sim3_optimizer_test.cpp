@@ -88,6 +88,63 @@ TEST(Sim3Optimizer, FailsWithTooFewInliers) {
   EXPECT_FALSE(r.success);
 }
 
+// Two monocular maps of one place seen from one spot (two clients on the same frames): camera 2
+// stands where camera 1 stands, map 2 is at 1/1.3 of map 1's scale, and each map's points sit a
+// few percent off along their rays (depth error; the pixels are exact). Reprojection is blind
+// to a scale about the shared centre.
+std::vector<Sim3Match> makeCoincidentViews(const Sim3d& S_12, int count, std::mt19937& rng) {
+  const CameraProjection cam = testCamera();
+  std::normal_distribution<double> depth_error(0.0, 0.04);
+  std::vector<Sim3Match> matches;
+  while (static_cast<int>(matches.size()) < count) {
+    const Eigen::Vector3d truth1 = test::randomVisiblePoint(SE3d(), rng, 3.0, 30.0);
+    const Eigen::Vector3d truth2 = S_12.inverse() * truth1;
+    Sim3Match m;
+    m.point1 = truth1 * (1.0 + depth_error(rng));
+    m.point2 = truth2 * (1.0 + depth_error(rng));
+    m.pixel1 = cam.project(truth1);
+    m.pixel2 = cam.project(truth2);
+    matches.push_back(m);
+  }
+  return matches;
+}
+
+TEST(Sim3Optimizer, TwoMapsSeenFromOneSpotTakeTheScaleFromThePointsRanges) {
+  std::mt19937 rng(43);
+  const Sim3d truth(1.3, Eigen::Quaterniond(so3Exp(Eigen::Vector3d(0.02, -0.04, 0.01))),
+                    Eigen::Vector3d::Zero());
+  const std::vector<Sim3Match> matches = makeCoincidentViews(truth, 150, rng);
+  // A RANSAC estimate whose scale came out of a few noisy points.
+  const Sim3d start(1.0, truth.rotation(), Eigen::Vector3d(0.01, 0.0, -0.02));
+
+  Sim3RefinementOptions options;
+  options.scale_from_ranges_below_baseline = 0.02;
+  const Sim3RefinementResult held = refineSim3(start, matches, testCamera(), testCamera(), options);
+  ASSERT_TRUE(held.success);
+  EXPECT_TRUE(held.scale_from_ranges);
+  EXPECT_NEAR(held.S_12.scale(), 1.3, 0.03);
+  EXPECT_LT(test::radToDeg(so3Log(held.S_12.rotation() * truth.rotation().conjugate()).norm()),
+            0.1);
+
+  // Reprojection alone leaves the scale wherever it started.
+  const Sim3RefinementResult free = refineSim3(start, matches, testCamera(), testCamera());
+  ASSERT_TRUE(free.success);
+  EXPECT_FALSE(free.scale_from_ranges);
+  EXPECT_GT(std::abs(free.S_12.scale() - 1.3), 0.1);
+}
+
+TEST(Sim3Optimizer, ViewsApartKeepTheScaleReprojectionSees) {
+  std::mt19937 rng(44);
+  const std::vector<Sim3Match> matches = makeMatches(kTrueS12, 80, rng);
+  Sim3RefinementOptions options;
+  options.scale_from_ranges_below_baseline = 0.02;
+  const Sim3d start = perturbSim3(kTrueS12, 1.08, test::degToRad(2.0), 0.05);
+  const Sim3RefinementResult r = refineSim3(start, matches, testCamera(), testCamera(), options);
+  ASSERT_TRUE(r.success);
+  EXPECT_FALSE(r.scale_from_ranges);
+  EXPECT_NEAR(r.S_12.scale(), 1.3, 1e-6);
+}
+
 TEST(Sim3Optimizer, RejectsBadInput) {
   std::mt19937 rng(44);
   std::vector<Sim3Match> matches = makeMatches(kTrueS12, 12, rng);
