@@ -118,14 +118,24 @@ nlohmann::json RouteFollowing::json(const Trajectory& ground_truth,
   }
   std::vector<AnnouncedCheckpoint> announced;
   std::size_t announced_without_truth = 0;
-  for (const Entry& e : instructions_) {
+  for (std::size_t i = 0; i < instructions_.size(); ++i) {
+    const Entry& e = instructions_[i];
     if (e.instruction.kind != InstructionKind::kCheckpointReached) continue;
     const auto found = truth_at.find(e.timestamp);
     if (found == truth_at.end()) {
       ++announced_without_truth;
       continue;
     }
-    announced.push_back({e.instruction.checkpoint, found->second});
+    // Where the camera truly came from: the frame before this one, when it was localised too
+    // (the navigator's path runs between poses in a row).
+    std::optional<Eigen::Vector3d> from;
+    if (i > 0 && instructions_[i - 1].instruction.kind != InstructionKind::kNoPose) {
+      const auto before = truth_at.find(instructions_[i - 1].timestamp);
+      if (before != truth_at.end()) from = before->second;
+    }
+    for (std::size_t k = e.instruction.first_checkpoint; k <= e.instruction.checkpoint; ++k) {
+      announced.push_back({k, found->second, from});
+    }
   }
   const CheckpointSuccess success =
       checkpointSuccess(checkpoints, announced, truth, options_.success_radius_m);

@@ -5,6 +5,17 @@
 #include <stdexcept>
 
 namespace edgeslam {
+namespace {
+
+double distanceToSegment(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                         const Eigen::Vector3d& b) {
+  const Eigen::Vector3d ab = b - a;
+  const double length2 = ab.squaredNorm();
+  const double t = length2 > 0.0 ? std::clamp((p - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
+  return (a + t * ab - p).norm();
+}
+
+}  // namespace
 
 CheckpointSuccess checkpointSuccess(const std::vector<Eigen::Vector3d>& checkpoints,
                                     const std::vector<AnnouncedCheckpoint>& announced,
@@ -14,8 +25,9 @@ CheckpointSuccess checkpointSuccess(const std::vector<Eigen::Vector3d>& checkpoi
   out.checkpoints = checkpoints.size();
   for (const Eigen::Vector3d& checkpoint : checkpoints) {
     double closest = std::numeric_limits<double>::infinity();
-    for (const Eigen::Vector3d& p : true_positions) {
-      closest = std::min(closest, (p - checkpoint).norm());
+    for (std::size_t i = 0; i < true_positions.size(); ++i) {
+      const Eigen::Vector3d& from = true_positions[i == 0 ? 0 : i - 1];
+      closest = std::min(closest, distanceToSegment(checkpoint, from, true_positions[i]));
     }
     out.closest_m.push_back(closest);
     if (closest <= radius_m) ++out.passed;
@@ -25,7 +37,8 @@ CheckpointSuccess checkpointSuccess(const std::vector<Eigen::Vector3d>& checkpoi
     if (a.checkpoint >= checkpoints.size()) {
       throw std::invalid_argument("an announced checkpoint the route does not have");
     }
-    const double error = (a.true_position - checkpoints[a.checkpoint]).norm();
+    const double error = distanceToSegment(checkpoints[a.checkpoint],
+                                           a.true_from.value_or(a.true_position), a.true_position);
     out.announced_error_m.push_back(error);
     if (error <= radius_m) reached[a.checkpoint] = true;
   }

@@ -67,6 +67,10 @@ std::string Instruction::text(std::size_t checkpoints) const {
                          kind == InstructionKind::kTurnLeft ? "left" : "right", turn_deg,
                          checkpoint + 1, checkpoints, distance_m);
     case InstructionKind::kCheckpointReached:
+      if (first_checkpoint < checkpoint) {
+        return fmt::format("checkpoints {}-{} of {} reached", first_checkpoint + 1, checkpoint + 1,
+                           checkpoints);
+      }
       return fmt::format("checkpoint {} of {} reached", checkpoint + 1, checkpoints);
     case InstructionKind::kOffRoute:
       return fmt::format("off route ({:.2f} m from it)", distance_m);
@@ -108,21 +112,30 @@ Instruction Navigator::update(const std::optional<SE3d>& T_cw) {
     out.checkpoint = count - 1;
     return out;
   }
-  if (!T_cw) return out;
+  if (!T_cw) {
+    previous_position_.reset();
+    return out;
+  }
   const SE3d T_wc = T_cw->inverse();
   const Eigen::Vector3d position = T_wc.translation();
-  // Reached: the farthest checkpoint within reach among the next few.
+  const Eigen::Vector3d from = previous_position_.value_or(position);
+  previous_position_ = position;
+  const auto passedWithin = [&](std::size_t k) {
+    return distanceToSegment(route_.checkpoints[k], from, position) <= reach_radius_m_;
+  };
+  // Reached: the farthest checkpoint within reach among the next few, then the ones right after
+  // it that the path since the last pose passed too.
   const std::size_t last = std::min(count - 1, next_ + options_.look_ahead);
   for (std::size_t k = last + 1; k-- > next_;) {
-    const double distance = (route_.checkpoints[k] - position).norm();
-    if (distance <= reach_radius_m_) {
-      reached_.push_back(k);
-      next_ = k + 1;
-      out.kind = InstructionKind::kCheckpointReached;
-      out.checkpoint = k;
-      out.distance_m = distance;
-      return out;
-    }
+    if (!passedWithin(k)) continue;
+    out.first_checkpoint = k;
+    while (k + 1 < count && passedWithin(k + 1)) ++k;
+    for (std::size_t j = out.first_checkpoint; j <= k; ++j) reached_.push_back(j);
+    next_ = k + 1;
+    out.kind = InstructionKind::kCheckpointReached;
+    out.checkpoint = k;
+    out.distance_m = (route_.checkpoints[k] - position).norm();
+    return out;
   }
   const double off = distanceToRoute(position);
   if (off > options_.off_route_m) {

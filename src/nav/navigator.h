@@ -13,8 +13,9 @@
 namespace edgeslam {
 
 struct NavigatorOptions {
-  // A checkpoint is reached when the estimated position comes this close (0: half the route's
-  // spacing, or 0.25 m for a route of given positions).
+  // A checkpoint is reached when the estimated path comes this close (0: half the route's
+  // spacing, or 0.25 m for a route of given positions). The path between two poses in a row
+  // counts: a car at 10 m/s and 10 fps moves 1 m a frame, past checkpoints 0.5 m apart.
   double reach_radius_m = 0.0;
   double off_route_m = 1.0;  // farther than this from the route's next legs: off route
   double straight_within_deg = 20.0;
@@ -40,8 +41,11 @@ const char* toString(InstructionKind kind);
 struct Instruction {
   InstructionKind kind = InstructionKind::kNoPose;
   std::size_t checkpoint = 0;  // 0-based: the one reached, or the next one to go to
-  double turn_deg = 0.0;       // by how much to turn (positive), for kTurnLeft/kTurnRight
-  double distance_m = 0.0;     // to the checkpoint, or from the route when off it
+  // kCheckpointReached: the first checkpoint reached by this update; the ones from it to
+  // `checkpoint` were all passed since the last pose.
+  std::size_t first_checkpoint = 0;
+  double turn_deg = 0.0;    // by how much to turn (positive), for kTurnLeft/kTurnRight
+  double distance_m = 0.0;  // to the checkpoint, or from the route when off it
   // One line for people: "turn left by 35 deg to checkpoint 4 of 12 (1.20 m)".
   std::string text(std::size_t checkpoints) const;
 };
@@ -69,6 +73,7 @@ class Navigator {
   NavigatorOptions options_;
   double reach_radius_m_ = 0.0;
   std::size_t next_ = 0;
+  std::optional<Eigen::Vector3d> previous_position_;  // the last update's, when it had a pose
   std::vector<std::size_t> reached_;
   std::size_t off_route_updates_ = 0;
 };

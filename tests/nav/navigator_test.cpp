@@ -91,6 +91,36 @@ TEST(Navigator, InOrderByDefaultSoAPathCrossingItselfDoesNotSkip) {
   EXPECT_EQ(skipping.update(cameraAt({0, 0, 0.4}, 0)).checkpoint, 3u);
 }
 
+TEST(Navigator, ACameraPassingSeveralCheckpointsBetweenTwoPosesReachesThemAll) {
+  // A car at 10 m/s and 10 fps on a route of checkpoints every 0.5 m: 1 m between poses, two
+  // checkpoints a frame, none of them nearer a pose than the 0.25 m reach radius but the first.
+  RouteRecord road = corner();
+  road.spacing_m = 0.5;
+  road.checkpoints.clear();
+  for (int i = 0; i <= 8; ++i) road.checkpoints.push_back({0.1, 0, 0.5 * i + 0.1});
+  Navigator navigator(road);
+  EXPECT_DOUBLE_EQ(navigator.reachRadius(), 0.25);
+  EXPECT_EQ(navigator.update(cameraAt({0, 0, 0}, 0)).checkpoint, 0u);
+  for (int frame = 1; frame <= 4; ++frame) {
+    const Instruction passed = navigator.update(cameraAt({0, 0, 1.0 * frame}, 0));
+    ASSERT_EQ(passed.kind, InstructionKind::kCheckpointReached) << "frame " << frame;
+    EXPECT_EQ(passed.first_checkpoint, 2u * static_cast<std::size_t>(frame) - 1);
+    EXPECT_EQ(passed.checkpoint, 2u * static_cast<std::size_t>(frame));
+  }
+  EXPECT_EQ(navigator.reached().size(), 9u);
+  EXPECT_EQ(navigator.update(cameraAt({0, 0, 5}, 0)).kind, InstructionKind::kArrived);
+  Instruction two;
+  two.kind = InstructionKind::kCheckpointReached;
+  two.first_checkpoint = 1;
+  two.checkpoint = 2;
+  EXPECT_EQ(two.text(9), "checkpoints 2-3 of 9 reached");
+  // A pose lost in between: the path is not drawn across the gap.
+  Navigator gap(road);
+  gap.update(cameraAt({0, 0, 0}, 0));
+  gap.update(std::nullopt);
+  EXPECT_NE(gap.update(cameraAt({0, 0, 1.0}, 0)).kind, InstructionKind::kCheckpointReached);
+}
+
 TEST(Navigator, BadRoutesAndOptionsAreRefused) {
   RouteRecord empty = corner();
   empty.checkpoints.clear();
