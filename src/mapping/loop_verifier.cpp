@@ -205,8 +205,9 @@ LoopVerification verifyLoopCandidates(KeyFrame* current, const std::vector<KeyFr
     const Sim3RefinementResult refined =
         refineSim3(estimate.cam1_from_cam2, set.matches, projection, projection, refine);
     if (!refined.success || refined.inliers < options.min_sim3_inliers) {
-      reject(fmt::format("{} BoW matches, {} RANSAC inliers, {} after refinement", bow_count,
-                         estimate.num_inliers, refined.inliers));
+      reject(fmt::format("{} BoW matches, {} RANSAC inliers, {} after refinement{}", bow_count,
+                         estimate.num_inliers, refined.inliers,
+                         refined.scale_from_ranges ? " (scale held at the points' ranges)" : ""));
       continue;
     }
     keepInliers(
