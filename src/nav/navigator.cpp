@@ -55,6 +55,16 @@ const char* toString(InstructionKind kind) {
 }
 
 std::string Instruction::text(std::size_t checkpoints) const {
+  if (kind == InstructionKind::kCheckpointReached && then) {
+    Instruction next;
+    next.kind = then->kind;
+    next.checkpoint = then->checkpoint;
+    next.turn_deg = then->turn_deg;
+    next.distance_m = then->distance_m;
+    Instruction reached = *this;
+    reached.then.reset();
+    return reached.text(checkpoints) + "; " + next.text(checkpoints);
+  }
   switch (kind) {
     case InstructionKind::kNoPose:
       return "localising...";
@@ -135,6 +145,7 @@ Instruction Navigator::update(const std::optional<SE3d>& T_cw) {
     out.kind = InstructionKind::kCheckpointReached;
     out.checkpoint = k;
     out.distance_m = (route_.checkpoints[k] - position).norm();
+    if (next_ < count) out.then = headingTo(T_wc);
     return out;
   }
   const double off = distanceToRoute(position);
@@ -145,22 +156,29 @@ Instruction Navigator::update(const std::optional<SE3d>& T_cw) {
     out.distance_m = off;
     return out;
   }
+  const Instruction::Heading heading = headingTo(T_wc);
+  out.kind = heading.kind;
+  out.checkpoint = heading.checkpoint;
+  out.turn_deg = heading.turn_deg;
+  out.distance_m = heading.distance_m;
+  return out;
+}
+
+Instruction::Heading Navigator::headingTo(const SE3d& T_wc) const {
+  Instruction::Heading out;
   const Eigen::Vector3d& up = route_.up;
-  const Eigen::Vector3d to_checkpoint = route_.checkpoints[next_] - position;
+  const Eigen::Vector3d to_checkpoint = route_.checkpoints[next_] - T_wc.translation();
   const Eigen::Vector3d heading = onGround(T_wc.rotationMatrix().col(2), up);
   const Eigen::Vector3d bearing = onGround(to_checkpoint, up);
   out.checkpoint = next_;
   out.distance_m = to_checkpoint.norm();
   if (heading.norm() < 1e-6 || bearing.norm() < 1e-6) {
-    out.kind = InstructionKind::kGoStraight;  // looking straight up or down, or on top of it
-    return out;
+    return out;  // go straight: looking straight up or down, or on top of it
   }
   // Counter-clockwise about up (seen from above) is to the left.
   const double angle =
       std::atan2(up.dot(heading.cross(bearing)), heading.dot(bearing)) * 180.0 / std::numbers::pi;
-  if (std::abs(angle) <= options_.straight_within_deg) {
-    out.kind = InstructionKind::kGoStraight;
-  } else {
+  if (std::abs(angle) > options_.straight_within_deg) {
     out.kind = angle > 0.0 ? InstructionKind::kTurnLeft : InstructionKind::kTurnRight;
     out.turn_deg = std::abs(angle);
   }

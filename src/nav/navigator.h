@@ -46,7 +46,17 @@ struct Instruction {
   std::size_t first_checkpoint = 0;
   double turn_deg = 0.0;    // by how much to turn (positive), for kTurnLeft/kTurnRight
   double distance_m = 0.0;  // to the checkpoint, or from the route when off it
-  // One line for people: "turn left by 35 deg to checkpoint 4 of 12 (1.20 m)".
+  // kCheckpointReached with checkpoints still ahead: the way on to the next one (go straight or
+  // turn), so that a camera reaching checkpoints every frame is still told where to go.
+  struct Heading {
+    InstructionKind kind = InstructionKind::kGoStraight;
+    std::size_t checkpoint = 0;
+    double turn_deg = 0.0;
+    double distance_m = 0.0;
+  };
+  std::optional<Heading> then;
+  // One line for people: "turn left by 35 deg to checkpoint 4 of 12 (1.20 m)", or
+  // "checkpoint 3 of 12 reached; go straight to checkpoint 4 of 12 (0.50 m)".
   std::string text(std::size_t checkpoints) const;
 };
 
@@ -68,6 +78,8 @@ class Navigator {
 
  private:
   double distanceToRoute(const Eigen::Vector3d& position) const;
+  // Go straight or turn, towards checkpoint `next_`, from the camera pose `T_wc`.
+  Instruction::Heading headingTo(const SE3d& T_wc) const;
 
   RouteRecord route_;
   NavigatorOptions options_;

@@ -106,6 +106,17 @@ TEST(Navigator, ACameraPassingSeveralCheckpointsBetweenTwoPosesReachesThemAll) {
     ASSERT_EQ(passed.kind, InstructionKind::kCheckpointReached) << "frame " << frame;
     EXPECT_EQ(passed.first_checkpoint, 2u * static_cast<std::size_t>(frame) - 1);
     EXPECT_EQ(passed.checkpoint, 2u * static_cast<std::size_t>(frame));
+    // Reaching checkpoints every frame, the driver is still told the way on.
+    if (frame < 4) {
+      ASSERT_TRUE(passed.then);
+      EXPECT_EQ(passed.then->kind, InstructionKind::kGoStraight);
+      EXPECT_EQ(passed.then->checkpoint, passed.checkpoint + 1);
+      EXPECT_EQ(passed.text(9).rfind("checkpoints ", 0), 0u) << passed.text(9);
+      EXPECT_NE(passed.text(9).find("reached; go straight to checkpoint"), std::string::npos)
+          << passed.text(9);
+    } else {
+      EXPECT_FALSE(passed.then);  // the last one: nothing ahead
+    }
   }
   EXPECT_EQ(navigator.reached().size(), 9u);
   EXPECT_EQ(navigator.update(cameraAt({0, 0, 5}, 0)).kind, InstructionKind::kArrived);
