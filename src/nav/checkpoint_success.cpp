@@ -4,18 +4,9 @@
 #include <limits>
 #include <stdexcept>
 
+#include "nav/path_distance.h"
+
 namespace edgeslam {
-namespace {
-
-double distanceToSegment(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
-                         const Eigen::Vector3d& b) {
-  const Eigen::Vector3d ab = b - a;
-  const double length2 = ab.squaredNorm();
-  const double t = length2 > 0.0 ? std::clamp((p - a).dot(ab) / length2, 0.0, 1.0) : 0.0;
-  return (a + t * ab - p).norm();
-}
-
-}  // namespace
 
 CheckpointSuccess checkpointSuccess(const std::vector<Eigen::Vector3d>& checkpoints,
                                     const std::vector<AnnouncedCheckpoint>& announced,

@@ -98,8 +98,10 @@ Sim3RefinementResult refineSim3(const Sim3d& initial_S_12, std::span<const Sim3M
   bool fix_scale = options.fix_scale;
   if (!fix_scale && options.scale_from_ranges_below_baseline > 0.0) {
     const std::optional<double> baseline = cameraBaselineOverRange(start, matches);
-    const std::optional<double> scale = scaleFromRanges(start, matches);
-    if (baseline && scale && *baseline<options.scale_from_ranges_below_baseline&& * scale> 0.0) {
+    const bool views_meet =
+        baseline.has_value() && *baseline < options.scale_from_ranges_below_baseline;
+    const std::optional<double> scale = views_meet ? scaleFromRanges(start, matches) : std::nullopt;
+    if (scale.has_value() && *scale > 0.0) {
       start = Sim3d(*scale, start.rotation(), start.translation());
       fix_scale = true;
       result.scale_from_ranges = true;
