@@ -16,7 +16,8 @@ KeyFrameSegmentationWorker::KeyFrameSegmentationWorker(std::shared_ptr<Segmenter
              {.capacity = std::max<std::size_t>(1, max_queued),
               .newest_first = true,
               .thread_nice = 0,
-              .on_failure = {}}) {
+              .on_failure = {},
+              .group = {}}) {
   queue_.start();
 }
 

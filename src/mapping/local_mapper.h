@@ -147,7 +147,7 @@ class LocalMapper : public KeyFrameSink {
   KeyFrameRedundancy redundancy(const KeyFrame& keyframe) const;  // under the map's mutex
   // Culls `keyframe` itself when an older keyframe covers its view (cull_revisits).
   bool cullRevisit(KeyFrame* keyframe);
-  bool hasPending() const;
+  bool hasPending(KeyFrame* keyframe) const;  // a keyframe of its client waits
   // Between keyframes: lets go of erased points so that the map can free them.
   void releaseErased();
 
@@ -163,7 +163,7 @@ class LocalMapper : public KeyFrameSink {
   LocalMapperStats stats_ GUARDED_BY(stats_mutex_);
   std::function<void(KeyFrame*)> on_mapped_;
   // Last: its thread, which uses everything above, ends before any of it is destroyed. Its
-  // giveWay() flag aborts a running local BA (a new keyframe, pause(), stop()).
+  // giveWay() flag aborts a running local BA (a new keyframe of the same client, pause(), stop()).
   QueuedWorker<KeyFrame*> queue_;
 };
 

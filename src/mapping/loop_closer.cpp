@@ -27,7 +27,7 @@ LoopCloser::LoopCloser(Map& map, const PinholeCamera& camera,
       mapper_(mapper),
       detector_(std::move(vocabulary), options_.detector),
       queue_("loop closing", [this](KeyFrame* keyframe) { closeLoopsAt(keyframe); },
-             {.capacity = 0, .thread_nice = options_.thread_nice, .on_failure = {}}) {}
+             {.capacity = 0, .thread_nice = options_.thread_nice, .on_failure = {}, .group = {}}) {}
 
 LoopCloser::~LoopCloser() {
   stop();

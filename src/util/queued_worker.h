@@ -8,9 +8,11 @@
 // emptied, later pushes are refused, whoever waits in waitUntilIdle() or pause() returns, and the
 // owner's failure handler hears the cause once, on the worker's thread. Unthreaded, processAll()
 // lets the exception reach its caller.
+#include <algorithm>
 #include <atomic>
 #include <condition_variable>
 #include <cstddef>
+#include <cstdint>
 #include <deque>
 #include <functional>
 #include <optional>
@@ -22,6 +24,7 @@
 
 namespace edgeslam {
 
+template <class Item>
 struct QueuedWorkerOptions {
   // 0: unbounded. Otherwise a push beyond it drops the oldest waiting item (counted in dropped()).
   std::size_t capacity = 0;
@@ -30,6 +33,9 @@ struct QueuedWorkerOptions {
   // Nice increment for the thread (util/thread_priority.h); 0 leaves it as it is.
   int thread_nice = 0;
   WorkerThread::FailureHandler on_failure;
+  // Items of different groups (the clients of one shared map) do not make each other give way:
+  // a push raises giveWay() only when it is of the group of the item in hand. None: one group.
+  std::function<std::uint64_t(const Item&)> group;
 };
 
 template <class Item>
@@ -38,7 +44,7 @@ class QueuedWorker {
   using Work = std::function<void(Item)>;
 
   // `name` says what the work is ("local mapping"): the failure cause reads "<name> failed: ...".
-  QueuedWorker(std::string name, Work work, QueuedWorkerOptions options = {})
+  QueuedWorker(std::string name, Work work, QueuedWorkerOptions<Item> options = {})
       : name_(std::move(name)), work_(std::move(work)), options_(std::move(options)) {}
   ~QueuedWorker() { stop(); }
   QueuedWorker(const QueuedWorker&) = delete;
@@ -78,12 +84,12 @@ class QueuedWorker {
     {
       MutexLock lock(mutex_);
       if (failed_ || stopping_) return false;
+      if (!group_in_hand_ || groupOf(item) == *group_in_hand_) give_way_ = true;
       queue_.push_back(std::move(item));
       if (options_.capacity > 0 && queue_.size() > options_.capacity) {
         queue_.pop_front();
         ++dropped_;
       }
-      give_way_ = true;
     }
     wake_.notify_one();
     return true;
@@ -136,6 +142,13 @@ class QueuedWorker {
     MutexLock lock(mutex_);
     return queue_.empty();
   }
+  // An item of `item`'s group waits (any item, without groups).
+  bool hasQueuedOfGroup(const Item& item) const {
+    MutexLock lock(mutex_);
+    const std::uint64_t group = groupOf(item);
+    return std::any_of(queue_.begin(), queue_.end(),
+                       [&](const Item& queued) { return groupOf(queued) == group; });
+  }
   std::size_t size() const {
     MutexLock lock(mutex_);
     return queue_.size();
@@ -164,6 +177,7 @@ class QueuedWorker {
         item.emplace(popNext());
         busy_ = true;
         give_way_ = false;
+        group_in_hand_ = groupOf(*item);
       }
       work_(std::move(*item));
     }
@@ -174,7 +188,12 @@ class QueuedWorker {
     if (queue_.empty()) return std::nullopt;
     std::optional<Item> item(popNext());
     give_way_ = false;
+    group_in_hand_ = groupOf(*item);
     return item;
+  }
+
+  std::uint64_t groupOf(const Item& item) const {
+    return options_.group ? options_.group(item) : 0;
   }
 
   Item popNext() REQUIRES(mutex_) {
@@ -201,7 +220,7 @@ class QueuedWorker {
 
   const std::string name_;
   const Work work_;
-  const QueuedWorkerOptions options_;
+  const QueuedWorkerOptions<Item> options_;
 
   mutable Mutex mutex_;
   std::condition_variable wake_;  // an item, resume() or stop() for the thread
@@ -213,6 +232,7 @@ class QueuedWorker {
   bool paused_ GUARDED_BY(mutex_) = false;
   bool stopping_ GUARDED_BY(mutex_) = false;
   bool failed_ GUARDED_BY(mutex_) = false;
+  std::optional<std::uint64_t> group_in_hand_ GUARDED_BY(mutex_);  // the last item taken's
   std::atomic<bool> give_way_{false};
   WorkerThread thread_;
 };

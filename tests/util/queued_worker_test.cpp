@@ -123,7 +123,7 @@ TEST(QueuedWorker, StopEndsAfterTheItemInHandAndLeavesTheRestQueued) {
 TEST(QueuedWorker, ItsThreadRunsAtTheGivenNiceIncrement) {
   std::atomic<int> nice{-100};
   QueuedWorker<int> worker("background", [&](int) { nice = currentThreadNice(); },
-                           {.capacity = 0, .thread_nice = 3, .on_failure = {}});
+                           {.capacity = 0, .thread_nice = 3, .on_failure = {}, .group = {}});
   worker.start();
   worker.push(1);
   worker.waitUntilIdle();
@@ -133,7 +133,7 @@ TEST(QueuedWorker, ItsThreadRunsAtTheGivenNiceIncrement) {
 TEST(QueuedWorker, AFullQueueDropsItsOldestItemAndCountsIt) {
   Record record;
   QueuedWorker<int> worker("bounded", [&](int item) { record.add(item); },
-                           {.capacity = 2, .thread_nice = 0, .on_failure = {}});
+                           {.capacity = 2, .thread_nice = 0, .on_failure = {}, .group = {}});
   for (int i = 1; i <= 5; ++i) EXPECT_TRUE(worker.push(i));
   EXPECT_EQ(worker.size(), 2u);
   EXPECT_EQ(worker.dropped(), 3u);
@@ -146,7 +146,7 @@ TEST(QueuedWorker, NewestFirstTakesTheLatestItemAndDropsTheOldestBeyondItsBound)
   Record record;
   QueuedWorker<int> worker(
       "newest first", [&](int item) { record.add(item); },
-      {.capacity = 3, .newest_first = true, .thread_nice = 0, .on_failure = {}});
+      {.capacity = 3, .newest_first = true, .thread_nice = 0, .on_failure = {}, .group = {}});
   for (int i = 1; i <= 5; ++i) EXPECT_TRUE(worker.push(i));
   EXPECT_EQ(worker.dropped(), 2u);
   worker.processAll();
@@ -184,6 +184,58 @@ TEST(QueuedWorker, PauseWaitsForTheItemInHandAndAsksItToGiveWay) {
   worker.resume();
 }
 
+TEST(QueuedWorker, AnItemOfAnotherGroupDoesNotMakeTheItemInHandGiveWay) {
+  // Groups are the tens: 11 and 12 are one client's, 21 another's.
+  std::atomic<bool> in_hand{false};
+  std::promise<void> gate;
+  std::shared_future<void> opened = gate.get_future().share();
+  QueuedWorker<int> worker("grouped",
+                           [&](int item) {
+                             if (item != 11) return;
+                             in_hand = true;
+                             opened.wait();
+                           },
+                           {.capacity = 0,
+                            .newest_first = false,
+                            .thread_nice = 0,
+                            .on_failure = {},
+                            .group = [](const int& item) -> std::uint64_t {
+                              return static_cast<std::uint64_t>(item / 10);
+                            }});
+  worker.push(11);
+  worker.start();
+  ASSERT_TRUE(becomesTrue(in_hand));
+  worker.push(21);
+  EXPECT_FALSE(worker.giveWay()->load());
+  EXPECT_TRUE(worker.hasQueuedOfGroup(21));
+  EXPECT_FALSE(worker.hasQueuedOfGroup(11));
+  worker.push(12);
+  EXPECT_TRUE(worker.giveWay()->load());
+  EXPECT_TRUE(worker.hasQueuedOfGroup(11));
+  gate.set_value();
+  worker.waitUntilIdle();
+}
+
+TEST(QueuedWorker, WithoutGroupsEveryPushMakesTheItemInHandGiveWay) {
+  std::atomic<bool> in_hand{false};
+  std::promise<void> gate;
+  std::shared_future<void> opened = gate.get_future().share();
+  QueuedWorker<int> worker("ungrouped", [&](int item) {
+    if (item != 11) return;
+    in_hand = true;
+    opened.wait();
+  });
+  worker.push(11);
+  worker.start();
+  ASSERT_TRUE(becomesTrue(in_hand));
+  EXPECT_FALSE(worker.hasQueuedOfGroup(11));
+  worker.push(21);
+  EXPECT_TRUE(worker.giveWay()->load());
+  EXPECT_TRUE(worker.hasQueuedOfGroup(11));
+  gate.set_value();
+  worker.waitUntilIdle();
+}
+
 TEST(QueuedWorker, AnExceptionEndsTheWorkerAlone) {
   Record record;
   std::promise<void> gate;
@@ -192,21 +244,24 @@ TEST(QueuedWorker, AnExceptionEndsTheWorkerAlone) {
   Mutex reports_mutex;
   std::vector<std::string> reports;
   std::thread::id reported_on;
-  QueuedWorker<int> worker(
-      "counting",
-      [&](int item) {
-        if (item == 2) {
-          in_hand = true;
-          opened.wait();
-          throw std::runtime_error("bad item 2");
-        }
-        record.add(item);
-      },
-      {.capacity = 0, .thread_nice = 0, .on_failure = [&](const std::string& cause) {
-         MutexLock lock(reports_mutex);
-         reports.push_back(cause);
-         reported_on = std::this_thread::get_id();
-       }});
+  QueuedWorker<int> worker("counting",
+                           [&](int item) {
+                             if (item == 2) {
+                               in_hand = true;
+                               opened.wait();
+                               throw std::runtime_error("bad item 2");
+                             }
+                             record.add(item);
+                           },
+                           {.capacity = 0,
+                            .thread_nice = 0,
+                            .on_failure =
+                                [&](const std::string& cause) {
+                                  MutexLock lock(reports_mutex);
+                                  reports.push_back(cause);
+                                  reported_on = std::this_thread::get_id();
+                                },
+                            .group = {}});
   for (int i = 1; i <= 4; ++i) ASSERT_TRUE(worker.push(i));
   worker.start();
   ASSERT_TRUE(becomesTrue(in_hand));
