@@ -143,11 +143,12 @@ TrackResult Tracker::track(std::size_t frame_index, double timestamp,
     MutexLock lock(map_.updateMutex());
     releaseErased();
     if (last_frame_ && last_frame_->T_cw) {
-      // The last frame's keyframe may have moved since (local BA): follow it.
+      // The last frame's keyframe may have moved since (local BA, a merge): follow it, through
+      // the spanning tree when the edge has culled it meanwhile. A merged client whose last
+      // keyframe was culled as a revisit of the other part kept its pre-merge pose and was lost.
       const FrameRecord& last_record = records_.back();
-      if (last_record.tracked && last_record.reference != nullptr &&
-          !last_record.reference->isBad()) {
-        last_frame_->T_cw = last_record.T_cr * last_record.reference->pose();
+      if (last_record.tracked && last_record.reference != nullptr) {
+        last_frame_->T_cw = last_record.T_cr * last_record.reference->latestPose();
       }
     }
     if (state_ == TrackingState::kOk) {

@@ -214,6 +214,16 @@ void EdgeMapSession::onKeyFrame(const KeyFrameUpload& upload, EdgeMapClientId cl
       throw;
     }
     map_.setChangeRecording(true);
+    if (record == &moved) {
+      // The client has them where it tracked them, in its part's frame before the merge: the
+      // next slice carries the move.
+      map_.setKeyFramePose(keyframe, keyframe->pose());
+      for (const MapPointRecord& point : new_points) {
+        if (MapPoint* p = map_.mapPoint(point.id); p != nullptr && !p->isBad()) {
+          map_.setPointPosition(p, p->position());
+        }
+      }
+    }
     // Where the edge's map differs from what the client sent, the slices say so.
     resolveUploadedPointConflicts(map_, conflicts);
     if (observer_ != nullptr) {

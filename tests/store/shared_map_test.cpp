@@ -68,7 +68,7 @@ struct StoredMapFigures {
 
 StoredMapFigures storedMap(const std::filesystem::path& store, const std::string& map,
                            const std::filesystem::path& ground_truth,
-                           const std::filesystem::path& work) {
+                           const std::filesystem::path& work, const std::string& align) {
   StoredMapFigures figures;
   const auto keyframes = work / (map + "_keyframes.tum");
   const auto exported = test::runEdgeslam("map export " + map + " --format tum --out " +
@@ -81,7 +81,7 @@ StoredMapFigures storedMap(const std::filesystem::path& store, const std::string
     if (frame > 549.5) ++figures.keyframes_second_only;
   }
   const auto ate = test::runEdgeslam("eval ate --gt " + ground_truth.string() + " --est " +
-                                         keyframes.string() + " --align se3 --json",
+                                         keyframes.string() + " --align " + align + " --json",
                                      false);
   const auto json = nlohmann::json::parse(ate.output, nullptr, false);
   if (json.is_object() && json.contains("rmse_m")) figures.ate_m = json["rmse_m"].get<double>();
@@ -115,16 +115,20 @@ void look(httplib::Client& viewer, const std::string& map, EdgeViewSeen& seen) {
   }
 }
 
-TEST(SharedMap, TwoClientsMappingOneMapAtOnceEndInOneFrame) {
+// RGB-D: the parts meet by SE(3). Monocular: each part has a scale of its own, met by Sim(3).
+class SharedMap : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(SharedMap, TwoClientsMappingOneMapAtOnceEndInOneFrame) {
+  const std::string sensor = GetParam();
   EDGESLAM_REQUIRE_SHARED(kSequence);
-  const auto work = test::freshTempDir("shared_map");
+  const auto work = test::freshTempDir("shared_map_" + sensor);
   const auto store = work / "store";
   const auto logs = work / "logs";
   std::filesystem::create_directories(logs);
   const std::string vocab =
-      " --vocab " + test::writeSmallVocabulary(test::freshTempDir("shared_map_vocab"));
+      " --vocab " + test::writeSmallVocabulary(test::freshTempDir("shared_map_vocab_" + sensor));
   const std::string dataset = " --dataset " + test::sharedPath(kSequence).string();
-  const int port = 47900 + static_cast<int>(::getpid() % 90);
+  const int port = 47900 + static_cast<int>(::getpid() % 90) + (sensor == "mono" ? 90 : 0);
   const std::string address = "127.0.0.1:" + std::to_string(port);
   test::ChildProcess server(test::edgeslamBinary(),
                             words("server --listen " + address + " --status-every 0" + vocab +
@@ -143,8 +147,8 @@ TEST(SharedMap, TwoClientsMappingOneMapAtOnceEndInOneFrame) {
                           const std::string& map) {
     return std::make_unique<test::ChildProcess>(
         test::edgeslamBinary(),
-        words("client --server " + address + dataset + " --frames " + frames +
-              " --sensor rgbd --map " + map + vocab + " --out " + (work / name).string()),
+        words("client --server " + address + dataset + " --frames " + frames + " --sensor " +
+              sensor + " --map " + map + vocab + " --out " + (work / name).string()),
         logs / (name + ".log"));
   };
   // The two halves at once, into one map.
@@ -158,6 +162,16 @@ TEST(SharedMap, TwoClientsMappingOneMapAtOnceEndInOneFrame) {
   }
   EXPECT_EQ(first->wait(kClientRun), 0) << first->log();
   EXPECT_EQ(second->wait(kClientRun), 0) << second->log();
+  // The client whose part moved goes on in the merged frame: no frame lost to the move (its last
+  // keyframe, culled as a revisit of the other part, once left it at its pre-merge pose).
+  for (const std::string name : {"first", "second"}) {
+    std::ifstream metrics_file(work / name / "metrics.json");
+    const auto metrics = nlohmann::json::parse(metrics_file, nullptr, false);
+    ASSERT_TRUE(metrics.is_object()) << name;
+    std::printf("%s client: %d frames lost, %d relocalisations\n", name.c_str(),
+                metrics.value("lost", -1), metrics.value("relocalizations", -1));
+    EXPECT_EQ(metrics.value("lost", -1), 0) << name << "\n" << server.log();
+  }
   // One client over the whole sequence into a map of its own: the accuracy to match.
   auto whole = client("whole", "0-999", "whole");
   EXPECT_EQ(whole->wait(kClientRun), 0) << whole->log();
@@ -184,9 +198,11 @@ TEST(SharedMap, TwoClientsMappingOneMapAtOnceEndInOneFrame) {
   EXPECT_EQ(info_json.value("sessions", 0), 2) << info.output;
 
   writeJointGroundTruth({work / "first", work / "second"}, work / "halves_truth.tum");
-  const StoredMapFigures shared = storedMap(store, "kitchen", work / "halves_truth.tum", work);
+  const std::string align = sensor == "mono" ? "sim3" : "se3";
+  const StoredMapFigures shared =
+      storedMap(store, "kitchen", work / "halves_truth.tum", work, align);
   const StoredMapFigures single =
-      storedMap(store, "whole", work / "whole" / "groundtruth.tum", work);
+      storedMap(store, "whole", work / "whole" / "groundtruth.tum", work, align);
   std::printf(
       "shared map: %zu keyframes (%zu of frames only the first client played, %zu only the "
       "second's), keyframe ATE %.2f cm; single client: %zu keyframes, %.2f cm (ratio %.2f)\n",
@@ -201,6 +217,9 @@ TEST(SharedMap, TwoClientsMappingOneMapAtOnceEndInOneFrame) {
   EXPECT_LT(shared.ate_m, 1.2 * single.ate_m + 0.005);
   std::filesystem::remove_all(work);
 }
+
+INSTANTIATE_TEST_SUITE_P(Sensors, SharedMap, ::testing::Values("rgbd", "mono"),
+                         [](const auto& param_info) { return param_info.param; });
 
 }  // namespace
 }  // namespace edgeslam
