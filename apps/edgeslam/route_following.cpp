@@ -15,15 +15,13 @@
 namespace edgeslam::cli {
 namespace {
 
-RouteRecord readRoute(const std::filesystem::path& store_directory, const std::string& map,
-                      const std::string& name) {
-  const auto store = openMapStore(store_directory, MapStoreAccess::kRead);
-  for (RouteRecord& route : store->listRoutes(map)) {
+RouteRecord readRoute(MapStore& store, const std::string& map, const std::string& name) {
+  for (RouteRecord& route : store.listRoutes(map)) {
     if (route.name == name) return std::move(route);
   }
   throw std::runtime_error(
       fmt::format("--route: map '{}' in {} has no route '{}' (make one with `edgeslam route make`)",
-                  map, store->location(), name));
+                  map, store.location(), name));
 }
 
 double median(std::vector<double> values) {
@@ -41,7 +39,16 @@ double maxOf(const std::vector<double>& values) {
 RouteFollowing::RouteFollowing(const std::filesystem::path& store_directory, const std::string& map,
                                const std::string& route, RouteFollowingOptions options)
     : map_(map), options_(options) {
-  navigator_.emplace(readRoute(store_directory, map, route), options_.navigator);
+  const auto store = openMapStore(store_directory, MapStoreAccess::kRead);
+  navigator_.emplace(readRoute(*store, map, route), options_.navigator);
+  // Metric when a session measured depth (monocular ones merged into it took its scale).
+  const std::optional<StoredMap> stored = store->loadMap(map);
+  if (stored && std::none_of(stored->sessions.begin(), stored->sessions.end(),
+                             [](const StoredSession& session) {
+                               return session.info.sensor != Sensor::kMonocular;
+                             })) {
+    unit_ = "map units";
+  }
 }
 
 const Instruction& RouteFollowing::addFrame(std::size_t frame, double timestamp,
@@ -52,7 +59,7 @@ const Instruction& RouteFollowing::addFrame(std::size_t frame, double timestamp,
 
 std::string RouteFollowing::lastText() const {
   if (instructions_.empty()) return "";
-  return last().text(navigator_->route().checkpoints.size());
+  return last().text(navigator_->route().checkpoints.size(), unit_);
 }
 
 int RouteFollowing::lastCheckpoint() const {
@@ -68,7 +75,8 @@ void RouteFollowing::writeInstructions(const std::filesystem::path& path) const 
   for (const Entry& e : instructions_) {
     out << fmt::format("{},{:.6f},{},{},{:.1f},{:.3f},\"{}\"\n", e.frame, e.timestamp,
                        toString(e.instruction.kind), e.instruction.checkpoint + 1,
-                       e.instruction.turn_deg, e.instruction.distance_m, e.instruction.text(count));
+                       e.instruction.turn_deg, e.instruction.distance_m,
+                       e.instruction.text(count, unit_));
   }
   if (!out) throw std::runtime_error(path.string() + ": cannot be written");
 }

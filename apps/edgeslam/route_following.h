@@ -54,6 +54,7 @@ class RouteFollowing {
     Instruction instruction;
   };
   std::string map_;
+  std::string unit_ = "m";  // of the map's distances: "map units" when it has no metric scale
   RouteFollowingOptions options_;
   std::optional<Navigator> navigator_;
   std::vector<Entry> instructions_;

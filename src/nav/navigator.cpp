@@ -48,7 +48,7 @@ const char* toString(InstructionKind kind) {
   return "?";
 }
 
-std::string Instruction::text(std::size_t checkpoints) const {
+std::string Instruction::text(std::size_t checkpoints, std::string_view unit) const {
   if (kind == InstructionKind::kCheckpointReached && then) {
     Instruction next;
     next.kind = then->kind;
@@ -57,19 +57,19 @@ std::string Instruction::text(std::size_t checkpoints) const {
     next.distance_m = then->distance_m;
     Instruction reached = *this;
     reached.then.reset();
-    return reached.text(checkpoints) + "; " + next.text(checkpoints);
+    return reached.text(checkpoints, unit) + "; " + next.text(checkpoints, unit);
   }
   switch (kind) {
     case InstructionKind::kNoPose:
       return "localising...";
     case InstructionKind::kGoStraight:
-      return fmt::format("go straight to checkpoint {} of {} ({:.2f} m)", checkpoint + 1,
-                         checkpoints, distance_m);
+      return fmt::format("go straight to checkpoint {} of {} ({:.2f} {})", checkpoint + 1,
+                         checkpoints, distance_m, unit);
     case InstructionKind::kTurnLeft:
     case InstructionKind::kTurnRight:
-      return fmt::format("turn {} by {:.0f} deg to checkpoint {} of {} ({:.2f} m)",
+      return fmt::format("turn {} by {:.0f} deg to checkpoint {} of {} ({:.2f} {})",
                          kind == InstructionKind::kTurnLeft ? "left" : "right", turn_deg,
-                         checkpoint + 1, checkpoints, distance_m);
+                         checkpoint + 1, checkpoints, distance_m, unit);
     case InstructionKind::kCheckpointReached:
       if (first_checkpoint < checkpoint) {
         return fmt::format("checkpoints {}-{} of {} reached", first_checkpoint + 1, checkpoint + 1,
@@ -77,7 +77,7 @@ std::string Instruction::text(std::size_t checkpoints) const {
       }
       return fmt::format("checkpoint {} of {} reached", checkpoint + 1, checkpoints);
     case InstructionKind::kOffRoute:
-      return fmt::format("off route ({:.2f} m from it)", distance_m);
+      return fmt::format("off route ({:.2f} {} from it)", distance_m, unit);
     case InstructionKind::kArrived:
       return fmt::format("arrived: all {} checkpoints behind", checkpoints);
   }

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "geometry/se3.h"
@@ -56,8 +57,9 @@ struct Instruction {
   };
   std::optional<Heading> then;
   // One line for people: "turn left by 35 deg to checkpoint 4 of 12 (1.20 m)", or
-  // "checkpoint 3 of 12 reached; go straight to checkpoint 4 of 12 (0.50 m)".
-  std::string text(std::size_t checkpoints) const;
+  // "checkpoint 3 of 12 reached; go straight to checkpoint 4 of 12 (0.50 m)". `unit`: of the
+  // map's distances ("map units" for a monocular map, which has no metric scale).
+  std::string text(std::size_t checkpoints, std::string_view unit = "m") const;
 };
 
 class Navigator {

@@ -132,6 +132,29 @@ TEST(Navigator, ACameraPassingSeveralCheckpointsBetweenTwoPosesReachesThemAll) {
   EXPECT_NE(gap.update(cameraAt({0, 0, 1.0}, 0)).kind, InstructionKind::kCheckpointReached);
 }
 
+TEST(Instruction, DistancesAreInTheMapsUnit) {
+  Instruction turn;
+  turn.kind = InstructionKind::kTurnRight;
+  turn.checkpoint = 3;
+  turn.turn_deg = 40;
+  turn.distance_m = 0.05;
+  EXPECT_EQ(turn.text(9), "turn right by 40 deg to checkpoint 4 of 9 (0.05 m)");
+  // A monocular map has no metric scale: its distances are not metres.
+  EXPECT_EQ(turn.text(9, "map units"),
+            "turn right by 40 deg to checkpoint 4 of 9 (0.05 map units)");
+  Instruction reached;
+  reached.kind = InstructionKind::kCheckpointReached;
+  reached.checkpoint = 2;
+  reached.first_checkpoint = 2;
+  reached.then = Instruction::Heading{InstructionKind::kGoStraight, 3, 0.0, 0.04};
+  EXPECT_EQ(reached.text(9, "map units"),
+            "checkpoint 3 of 9 reached; go straight to checkpoint 4 of 9 (0.04 map units)");
+  Instruction off;
+  off.kind = InstructionKind::kOffRoute;
+  off.distance_m = 1.5;
+  EXPECT_EQ(off.text(9, "map units"), "off route (1.50 map units from it)");
+}
+
 TEST(Navigator, BadRoutesAndOptionsAreRefused) {
   RouteRecord empty = corner();
   empty.checkpoints.clear();
