@@ -205,8 +205,14 @@ void Map::restoreKeyFrame(KeyFrame* keyframe, std::shared_ptr<const FrameFeature
   --evicted_keyframes_;
 }
 
-void Map::eraseKeyFrame(KeyFrame* keyframe) {
+void Map::eraseKeyFrame(KeyFrame* keyframe, KeyFrame* covered_by) {
   if (keyframe->bad_ || keyframe == origin_ || keyframe->protected_from_culling_) return;
+  if (covered_by != nullptr && covered_by != keyframe && !covered_by->bad_ &&
+      covered_by != keyframe->parent_ && !hangsFrom(covered_by, keyframe)) {
+    if (keyframe->parent_ != nullptr) keyframe->parent_->children_.erase(keyframe);
+    keyframe->parent_ = covered_by;
+    covered_by->children_.insert(keyframe);
+  }
   unlinkConnections(keyframe);
   for (std::size_t i = 0; i < keyframe->points_.size(); ++i) {
     if (MapPoint* p = keyframe->points_[i]) eraseObservation(p, keyframe);
@@ -253,6 +259,15 @@ void Map::eraseKeyFrame(KeyFrame* keyframe) {
   record().keyFrameErased(keyframe->id());
   auto node = keyframes_.extract(keyframe->id());
   if (!node.empty()) retire(std::move(node.mapped()));
+}
+
+bool Map::hangsFrom(const KeyFrame* keyframe, const KeyFrame* ancestor) const {
+  std::size_t steps = 0;
+  for (const KeyFrame* kf = keyframe; kf != nullptr && steps <= keyframes_.size();
+       kf = kf->parent_, ++steps) {
+    if (kf == ancestor) return true;
+  }
+  return false;
 }
 
 void Map::hangTreeFrom(KeyFrame* keyframe, KeyFrame* parent) {

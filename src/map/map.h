@@ -87,12 +87,17 @@ class Map {
   void updateConnections(KeyFrame* keyframe) REQUIRES(update_mutex_);
   // Removes a redundant keyframe: unlinks its observations and re-parents its spanning-tree
   // children.
-  void eraseKeyFrame(KeyFrame* keyframe) REQUIRES(update_mutex_);
+  // `covered_by`: the keyframe that saw the same (a revisit culled): the erased keyframe hangs
+  // from it first, so its children, its pose and whoever follows the tree land there, where the
+  // camera is, not at its old parent (on a merged map, possibly far behind).
+  void eraseKeyFrame(KeyFrame* keyframe, KeyFrame* covered_by = nullptr) REQUIRES(update_mutex_);
   void addLoopEdge(KeyFrame* a, KeyFrame* b) REQUIRES(update_mutex_);
   // Joins two spanning trees (two parts of the map merged): `keyframe` becomes the root of its
   // own tree (the links on its way to the old root turn round), then a child of `parent`, which
   // must be in another tree. The keyframes whose parent changed are recorded as updated.
   void hangTreeFrom(KeyFrame* keyframe, KeyFrame* parent) REQUIRES(update_mutex_);
+  // `ancestor` is `keyframe` or on its way to the root of the spanning tree.
+  bool hangsFrom(const KeyFrame* keyframe, const KeyFrame* ancestor) const REQUIRES(update_mutex_);
   // A replica bounding what it holds: the keyframe keeps its id, pose and spanning-tree links (so
   // poses relative to it still follow corrections) but drops its features, its observations and
   // its covisibility links; points left without any observation are erased. No-op when bad or

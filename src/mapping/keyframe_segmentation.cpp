@@ -17,7 +17,8 @@ KeyFrameSegmentationWorker::KeyFrameSegmentationWorker(std::shared_ptr<Segmenter
               .newest_first = true,
               .thread_nice = 0,
               .on_failure = {},
-              .group = {}}) {
+              .group = {},
+              .backlog = 0}) {
   queue_.start();
 }
 

@@ -34,7 +34,8 @@ LocalMapper::LocalMapper(Map& map, const PinholeCamera& camera, LocalMapperOptio
               .on_failure = {},
               .group = [](KeyFrame* const& keyframe) -> std::uint64_t {
                 return idOrigin(keyframe->id());
-              }}) {}
+              },
+              .backlog = options_.max_queue}) {}
 
 LocalMapper::~LocalMapper() {
   stop();
@@ -72,10 +73,11 @@ void LocalMapper::onMapReset() {
 }
 
 bool LocalMapper::hasPending(KeyFrame* keyframe) const {
-  // Only the keyframe's own client's: it is the one that tracks on from them. Another client's
+  // The keyframe's own client's: it is the one that tracks on from them. Another client's
   // waiting keyframe cut this one's mapping short whenever the two interleaved: two monocular
-  // clients mapping redkitchen at once tracked ~50 points where one alone tracked ~150.
-  return queue_.hasQueuedOfGroup(keyframe);
+  // clients mapping redkitchen at once tracked ~50 points where one alone tracked ~150. Unless
+  // the clients together made a backlog: then mapping in short keeps up with them.
+  return queue_.hasQueuedOfGroup(keyframe) || queue_.size() >= options_.max_queue;
 }
 
 LocalMapperStats LocalMapper::stats() const {
@@ -391,7 +393,7 @@ bool LocalMapper::cullRevisit(KeyFrame* keyframe) {
         "points shared, {:.3f} apart)",
         keyframe->frameIndex(), older->frameIndex(), keyframe->weight(older),
         (older->cameraCenter() - keyframe->cameraCenter()).norm());
-    map_.eraseKeyFrame(keyframe);
+    map_.eraseKeyFrame(keyframe, older);
     MutexLock stats_lock(stats_mutex_);
     ++stats_.keyframes_culled;
     ++stats_.revisit_keyframes_culled;

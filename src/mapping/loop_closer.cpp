@@ -27,7 +27,11 @@ LoopCloser::LoopCloser(Map& map, const PinholeCamera& camera,
       mapper_(mapper),
       detector_(std::move(vocabulary), options_.detector),
       queue_("loop closing", [this](KeyFrame* keyframe) { closeLoopsAt(keyframe); },
-             {.capacity = 0, .thread_nice = options_.thread_nice, .on_failure = {}, .group = {}}) {}
+             {.capacity = 0,
+              .thread_nice = options_.thread_nice,
+              .on_failure = {},
+              .group = {},
+              .backlog = 0}) {}
 
 LoopCloser::~LoopCloser() {
   stop();

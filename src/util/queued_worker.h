@@ -34,8 +34,10 @@ struct QueuedWorkerOptions {
   int thread_nice = 0;
   WorkerThread::FailureHandler on_failure;
   // Items of different groups (the clients of one shared map) do not make each other give way:
-  // a push raises giveWay() only when it is of the group of the item in hand. None: one group.
+  // a push raises giveWay() only when it is of the group of the item in hand, or when it makes
+  // `backlog` items wait (0: never). No group function: one group.
   std::function<std::uint64_t(const Item&)> group;
+  std::size_t backlog = 0;
 };
 
 template <class Item>
@@ -84,11 +86,14 @@ class QueuedWorker {
     {
       MutexLock lock(mutex_);
       if (failed_ || stopping_) return false;
-      if (!group_in_hand_ || groupOf(item) == *group_in_hand_) give_way_ = true;
+      const bool same_group = !group_in_hand_ || groupOf(item) == *group_in_hand_;
       queue_.push_back(std::move(item));
       if (options_.capacity > 0 && queue_.size() > options_.capacity) {
         queue_.pop_front();
         ++dropped_;
+      }
+      if (same_group || (options_.backlog > 0 && queue_.size() >= options_.backlog)) {
+        give_way_ = true;
       }
     }
     wake_.notify_one();

@@ -124,6 +124,45 @@ TEST(Map, ErasedKeyFrameFollowsItsParentsLaterCorrection) {
   EXPECT_TRUE(t.map.changes().keyframes_erased.contains(kf1->id()));
 }
 
+TEST(Map, AKeyFrameCulledAsARevisitHangsFromTheKeyFrameThatSawTheSame) {
+  // kf0 <- kf1 <- kf2 (kf2 the newest, just mapped), and kf3 elsewhere in the tree (another
+  // client's, merged) at kf2's place. Culled for kf3, kf2 and whoever hangs from it follow kf3:
+  // on a merged map its old parent may be far behind the camera.
+  TwoKeyFrames t;
+  MutexLock lock(t.map.updateMutex());
+  const auto v2 = t.scene.view(test::poseAt({0.4, 0, 0}), 0, false);
+  KeyFrame* kf2 = t.scene.addKeyFrame(t.map, v2, 2, true);
+  KeyFrame* kf3 = t.scene.addKeyFrame(t.map, v2, 3, true);
+  t.map.hangTreeFrom(kf2, t.kf1);
+  t.map.hangTreeFrom(kf3, t.kf0);
+  const auto v4 = t.scene.view(test::poseAt({0.5, 0, 0}), 0, false);
+  KeyFrame* kf4 = t.scene.addKeyFrame(t.map, v4, 4, true);
+  t.map.hangTreeFrom(kf4, kf2);
+  ASSERT_EQ(kf2->parent(), t.kf1);
+  EXPECT_TRUE(t.map.hangsFrom(kf4, t.kf0));
+  EXPECT_FALSE(t.map.hangsFrom(kf3, kf2));
+
+  t.map.eraseKeyFrame(kf2, kf3);
+  EXPECT_TRUE(kf2->isBad());
+  EXPECT_EQ(kf2->parent(), kf3);
+  EXPECT_EQ(kf4->parent(), kf3);
+  EXPECT_TRUE(kf3->children().contains(kf4));
+  EXPECT_FALSE(t.kf1->children().contains(kf2));
+  // Its latest pose follows kf3 now.
+  const SE3d kf3_before = kf3->pose();
+  Vector6d shift;
+  shift << 0.1, 0, 0, 0, 0, 0;
+  t.map.setKeyFramePose(kf3, kf3_before * SE3d::exp(shift));
+  EXPECT_LT((kf2->latestPose().log() - kf3->pose().log()).norm(), 1e-9);
+
+  // A keyframe is never hung from its own descendant (no cycle): it stays with its parent.
+  KeyFrame* kf5 = t.scene.addKeyFrame(t.map, v4, 5, true);
+  t.map.hangTreeFrom(kf5, kf4);
+  t.map.eraseKeyFrame(kf4, kf5);
+  EXPECT_EQ(kf4->parent(), kf3);
+  EXPECT_EQ(kf5->parent(), kf3);
+}
+
 TEST(Map, TheOriginKeyFrameIsNeverErased) {
   TwoKeyFrames t;
   MutexLock lock(t.map.updateMutex());

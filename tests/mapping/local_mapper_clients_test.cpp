@@ -44,7 +44,7 @@ class LocalMapperClients : public ::testing::Test {
   SyntheticScene scene{300, 7};
   Map map{0};
   LocalMapper mapper{map, scene.camera(), edgeOptions()};
-  std::uint64_t next_id[3] = {0, 0, 0};
+  std::uint64_t next_id[5] = {0, 0, 0, 0, 0};
 };
 
 TEST_F(LocalMapperClients, AnotherClientsWaitingKeyFrameDoesNotCutAKeyFramesMappingShort) {
@@ -57,6 +57,21 @@ TEST_F(LocalMapperClients, AnotherClientsWaitingKeyFrameDoesNotCutAKeyFramesMapp
   mapper.insertKeyFrame(keyFrameOf(2, 0, 1.0));
   mapper.processAll();
   EXPECT_EQ(localBundleAdjustments(), before + 2);
+}
+
+TEST_F(LocalMapperClients, ABacklogOfOtherClientsKeyFramesCutsItShort) {
+  for (std::size_t frame : {0u, 10u}) mapper.insertKeyFrame(keyFrameOf(1, frame, 0.01 * frame));
+  mapper.processAll();
+  const std::size_t before = localBundleAdjustments();
+
+  // Three others wait (LocalMapperOptions::max_queue): mapping in short keeps up with them.
+  mapper.insertKeyFrame(keyFrameOf(1, 20, 0.2));
+  for (std::uint8_t client = 2; client <= 4; ++client) {
+    mapper.insertKeyFrame(keyFrameOf(client, 0, 1.0 * client));
+  }
+  mapper.processAll();
+  // The first mapped with 3 keyframes behind it, in short; the others in full.
+  EXPECT_EQ(localBundleAdjustments(), before + 3);
 }
 
 TEST_F(LocalMapperClients, AKeyFrameWhoseOwnClientSentTheNextIsMappedShort) {

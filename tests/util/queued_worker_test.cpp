@@ -122,8 +122,9 @@ TEST(QueuedWorker, StopEndsAfterTheItemInHandAndLeavesTheRestQueued) {
 
 TEST(QueuedWorker, ItsThreadRunsAtTheGivenNiceIncrement) {
   std::atomic<int> nice{-100};
-  QueuedWorker<int> worker("background", [&](int) { nice = currentThreadNice(); },
-                           {.capacity = 0, .thread_nice = 3, .on_failure = {}, .group = {}});
+  QueuedWorker<int> worker(
+      "background", [&](int) { nice = currentThreadNice(); },
+      {.capacity = 0, .thread_nice = 3, .on_failure = {}, .group = {}, .backlog = 0});
   worker.start();
   worker.push(1);
   worker.waitUntilIdle();
@@ -132,8 +133,9 @@ TEST(QueuedWorker, ItsThreadRunsAtTheGivenNiceIncrement) {
 
 TEST(QueuedWorker, AFullQueueDropsItsOldestItemAndCountsIt) {
   Record record;
-  QueuedWorker<int> worker("bounded", [&](int item) { record.add(item); },
-                           {.capacity = 2, .thread_nice = 0, .on_failure = {}, .group = {}});
+  QueuedWorker<int> worker(
+      "bounded", [&](int item) { record.add(item); },
+      {.capacity = 2, .thread_nice = 0, .on_failure = {}, .group = {}, .backlog = 0});
   for (int i = 1; i <= 5; ++i) EXPECT_TRUE(worker.push(i));
   EXPECT_EQ(worker.size(), 2u);
   EXPECT_EQ(worker.dropped(), 3u);
@@ -144,9 +146,13 @@ TEST(QueuedWorker, AFullQueueDropsItsOldestItemAndCountsIt) {
 
 TEST(QueuedWorker, NewestFirstTakesTheLatestItemAndDropsTheOldestBeyondItsBound) {
   Record record;
-  QueuedWorker<int> worker(
-      "newest first", [&](int item) { record.add(item); },
-      {.capacity = 3, .newest_first = true, .thread_nice = 0, .on_failure = {}, .group = {}});
+  QueuedWorker<int> worker("newest first", [&](int item) { record.add(item); },
+                           {.capacity = 3,
+                            .newest_first = true,
+                            .thread_nice = 0,
+                            .on_failure = {},
+                            .group = {},
+                            .backlog = 0});
   for (int i = 1; i <= 5; ++i) EXPECT_TRUE(worker.push(i));
   EXPECT_EQ(worker.dropped(), 2u);
   worker.processAll();
@@ -201,7 +207,8 @@ TEST(QueuedWorker, AnItemOfAnotherGroupDoesNotMakeTheItemInHandGiveWay) {
                             .on_failure = {},
                             .group = [](const int& item) -> std::uint64_t {
                               return static_cast<std::uint64_t>(item / 10);
-                            }});
+                            },
+                            .backlog = 3});
   worker.push(11);
   worker.start();
   ASSERT_TRUE(becomesTrue(in_hand));
@@ -212,6 +219,36 @@ TEST(QueuedWorker, AnItemOfAnotherGroupDoesNotMakeTheItemInHandGiveWay) {
   worker.push(12);
   EXPECT_TRUE(worker.giveWay()->load());
   EXPECT_TRUE(worker.hasQueuedOfGroup(11));
+  gate.set_value();
+  worker.waitUntilIdle();
+}
+
+TEST(QueuedWorker, ABacklogOfOtherGroupsMakesTheItemInHandGiveWay) {
+  std::atomic<bool> in_hand{false};
+  std::promise<void> gate;
+  std::shared_future<void> opened = gate.get_future().share();
+  QueuedWorker<int> worker("backlogged",
+                           [&](int item) {
+                             if (item != 11) return;
+                             in_hand = true;
+                             opened.wait();
+                           },
+                           {.capacity = 0,
+                            .newest_first = false,
+                            .thread_nice = 0,
+                            .on_failure = {},
+                            .group = [](const int& item) -> std::uint64_t {
+                              return static_cast<std::uint64_t>(item / 10);
+                            },
+                            .backlog = 3});
+  worker.push(11);
+  worker.start();
+  ASSERT_TRUE(becomesTrue(in_hand));
+  worker.push(21);
+  worker.push(31);
+  EXPECT_FALSE(worker.giveWay()->load());
+  worker.push(41);  // three waiting
+  EXPECT_TRUE(worker.giveWay()->load());
   gate.set_value();
   worker.waitUntilIdle();
 }
@@ -261,7 +298,8 @@ TEST(QueuedWorker, AnExceptionEndsTheWorkerAlone) {
                                   reports.push_back(cause);
                                   reported_on = std::this_thread::get_id();
                                 },
-                            .group = {}});
+                            .group = {},
+                            .backlog = 0});
   for (int i = 1; i <= 4; ++i) ASSERT_TRUE(worker.push(i));
   worker.start();
   ASSERT_TRUE(becomesTrue(in_hand));
