@@ -1,9 +1,10 @@
 // Two clients mapping one map at once, as a user meets it (issue "Map service II"): a real edge
-// server with a store, two real clients playing redkitchen RGB-D frames 0-549 and 450-999 into
-// `--map kitchen` at the same time. The second client starts where the map has nothing of its
-// own yet: it maps in a part of its own, and a loop between the two parts merges them. The stored
-// map then holds both clients' keyframes in one frame: its keyframe ATE, with one SE(3) alignment
-// for all of them, is compared with a single client's over the whole sequence into its own map.
+// server with a store, two real clients (RGB-D, then monocular) playing redkitchen frames 0-549
+// and 450-999 into `--map kitchen` at the same time. The second client starts where the map has
+// nothing of its own yet: it maps in a part of its own, and a loop between the two parts merges
+// them. The stored map then holds both clients' keyframes in one frame: its keyframe ATE, with one
+// alignment for all of them (SE(3), Sim(3) for monocular), is compared with a single client's over
+// the whole sequence into its own map; neither client may lose a frame.
 // The server's edge view is watched meanwhile: one map with both clients' trajectories, the merge
 // drawn and told as an event.
 #include <gtest/gtest.h>
