@@ -54,6 +54,7 @@ nlohmann::json summaryJson(const MapSummary& m) {
           {"keyframes", m.keyframes},
           {"points", m.points},
           {"sessions", m.sessions},
+          {"metric", m.metric},
           {"bytes", m.bytes},
           {"created", isoTime(m.created)},
           {"updated", isoTime(m.updated)},

@@ -41,14 +41,8 @@ RouteFollowing::RouteFollowing(const std::filesystem::path& store_directory, con
     : map_(map), options_(options) {
   const auto store = openMapStore(store_directory, MapStoreAccess::kRead);
   navigator_.emplace(readRoute(*store, map, route), options_.navigator);
-  // Metric when a session measured depth (monocular ones merged into it took its scale).
-  const std::optional<StoredMap> stored = store->loadMap(map);
-  if (stored && std::none_of(stored->sessions.begin(), stored->sessions.end(),
-                             [](const StoredSession& session) {
-                               return session.info.sensor != Sensor::kMonocular;
-                             })) {
-    unit_ = "map units";
-  }
+  const std::optional<MapSummary> summary = store->mapInfo(map);
+  if (summary && !summary->metric) unit_ = "map units";
 }
 
 const Instruction& RouteFollowing::addFrame(std::size_t frame, double timestamp,

@@ -25,6 +25,9 @@ struct MapSummary {
   std::uint64_t keyframes = 0;
   std::uint64_t points = 0;
   std::uint64_t sessions = 0;
+  // A session measured depth (RGB-D or stereo): the map has a metric scale. Monocular sessions
+  // merged into such a map took its scale; a map of monocular sessions only has none.
+  bool metric = false;
   std::uint64_t bytes = 0;  // payload bytes of the map's rows (blobs and values), roughly its share
   double created = 0.0;     // Unix seconds
   double updated = 0.0;

@@ -179,6 +179,12 @@ MapSummary SqliteMapStore::summary(std::int64_t map_id, const std::string& name)
     if (s.step()) out.sessions = static_cast<std::uint64_t>(s.columnInt(0));
   }
   {
+    SqliteStatement s(db_, "SELECT count(*) FROM sessions WHERE map_id = ? AND sensor != ?");
+    s.bind(1, map_id);
+    s.bind(2, std::string(toString(Sensor::kMonocular)));
+    if (s.step()) out.metric = s.columnInt(0) > 0;
+  }
+  {
     SqliteStatement s(db_,
                       "SELECT count(*), coalesce(sum(length(pose) + length(keypoints) + "
                       "length(descriptors) + length(depth) + length(right_u) + 48), 0) FROM "

@@ -39,31 +39,32 @@ class LocalMapperClients : public ::testing::Test {
     return kf;
   }
 
-  std::size_t localBundleAdjustments() const { return mapper.stats().local_ba_runs; }
+  // Client 1's first two keyframes mapped, each in full.
+  void SetUp() override {
+    for (std::size_t frame : {0u, 10u}) mapper.insertKeyFrame(keyFrameOf(1, frame, 0.01 * frame));
+    mapper.processAll();
+    ba_before = mapper.stats().local_ba_runs;
+  }
+
+  // Keyframes mapped in full (with their local BA) since SetUp.
+  std::size_t mappedInFull() const { return mapper.stats().local_ba_runs - ba_before; }
 
   SyntheticScene scene{300, 7};
   Map map{0};
   LocalMapper mapper{map, scene.camera(), edgeOptions()};
   std::uint64_t next_id[5] = {0, 0, 0, 0, 0};
+  std::size_t ba_before = 0;
 };
 
 TEST_F(LocalMapperClients, AnotherClientsWaitingKeyFrameDoesNotCutAKeyFramesMappingShort) {
-  for (std::size_t frame : {0u, 10u}) mapper.insertKeyFrame(keyFrameOf(1, frame, 0.01 * frame));
-  mapper.processAll();
-  const std::size_t before = localBundleAdjustments();
-
   // Client 1's keyframe mapped while client 2's waits behind it: both get their local BA.
   mapper.insertKeyFrame(keyFrameOf(1, 20, 0.2));
   mapper.insertKeyFrame(keyFrameOf(2, 0, 1.0));
   mapper.processAll();
-  EXPECT_EQ(localBundleAdjustments(), before + 2);
+  EXPECT_EQ(mappedInFull(), 2u);
 }
 
 TEST_F(LocalMapperClients, ABacklogOfOtherClientsKeyFramesCutsItShort) {
-  for (std::size_t frame : {0u, 10u}) mapper.insertKeyFrame(keyFrameOf(1, frame, 0.01 * frame));
-  mapper.processAll();
-  const std::size_t before = localBundleAdjustments();
-
   // Three others wait (LocalMapperOptions::max_queue): mapping in short keeps up with them.
   mapper.insertKeyFrame(keyFrameOf(1, 20, 0.2));
   for (std::uint8_t client = 2; client <= 4; ++client) {
@@ -71,18 +72,14 @@ TEST_F(LocalMapperClients, ABacklogOfOtherClientsKeyFramesCutsItShort) {
   }
   mapper.processAll();
   // The first mapped with 3 keyframes behind it, in short; the others in full.
-  EXPECT_EQ(localBundleAdjustments(), before + 3);
+  EXPECT_EQ(mappedInFull(), 3u);
 }
 
 TEST_F(LocalMapperClients, AKeyFrameWhoseOwnClientSentTheNextIsMappedShort) {
-  for (std::size_t frame : {0u, 10u}) mapper.insertKeyFrame(keyFrameOf(1, frame, 0.01 * frame));
-  mapper.processAll();
-  const std::size_t before = localBundleAdjustments();
-
   mapper.insertKeyFrame(keyFrameOf(1, 20, 0.2));
   mapper.insertKeyFrame(keyFrameOf(1, 30, 0.3));
   mapper.processAll();
-  EXPECT_EQ(localBundleAdjustments(), before + 1);  // the last one only
+  EXPECT_EQ(mappedInFull(), 1u);  // the last one only
 }
 
 }  // namespace

@@ -212,5 +212,18 @@ TEST(MapStore, NamedMapsLiveSideBySideAndRemoveAlone) {
   std::filesystem::remove_all(dir);
 }
 
+TEST(MapStore, AMapIsMetricOnceASessionMeasuredDepth) {
+  const auto dir = freshStoreDir("metric");
+  SmallMap small;
+  auto store = openMapStore(dir, MapStoreAccess::kServe);
+  StoredSessionInfo mono = small.info();
+  mono.sensor = Sensor::kMonocular;
+  store->beginSession("walk", mono);
+  EXPECT_FALSE(store->mapInfo("walk")->metric);  // monocular only: no metric scale
+  store->beginSession("walk", small.info());     // RGB-D
+  EXPECT_TRUE(store->mapInfo("walk")->metric);
+  std::filesystem::remove_all(dir);
+}
+
 }  // namespace
 }  // namespace edgeslam

@@ -190,87 +190,78 @@ TEST(QueuedWorker, PauseWaitsForTheItemInHandAndAsksItToGiveWay) {
   worker.resume();
 }
 
+// A started worker holding item 11 in hand until release(). Grouped: the groups are the tens
+// (11 and 12 are one client's, 21 another's), and a backlog of 3 waiting items gives way too.
+class HeldItem {
+ public:
+  explicit HeldItem(bool grouped)
+      : worker_("held",
+                [this](int item) {
+                  if (item != 11) return;
+                  in_hand_ = true;
+                  opened_.wait();
+                },
+                {.capacity = 0,
+                 .newest_first = false,
+                 .thread_nice = 0,
+                 .on_failure = {},
+                 .group = grouped ? [](const int& item) -> std::uint64_t {
+                   return static_cast<std::uint64_t>(item / 10);
+                 }
+                 : std::function<std::uint64_t(const int&)>{},
+                 .backlog = grouped ? 3u : 0u}) {
+    worker_.push(11);
+    worker_.start();
+  }
+  ~HeldItem() {
+    release();
+    worker_.waitUntilIdle();
+  }
+  bool inHand() const { return becomesTrue(in_hand_); }
+  QueuedWorker<int>& worker() { return worker_; }
+  bool givesWay() const { return worker_.giveWay()->load(); }
+  void release() {
+    if (!released_) gate_.set_value();
+    released_ = true;
+  }
+
+ private:
+  std::atomic<bool> in_hand_{false};
+  std::promise<void> gate_;
+  std::shared_future<void> opened_ = gate_.get_future().share();
+  bool released_ = false;
+  QueuedWorker<int> worker_;  // last: its thread uses the above
+};
+
 TEST(QueuedWorker, AnItemOfAnotherGroupDoesNotMakeTheItemInHandGiveWay) {
-  // Groups are the tens: 11 and 12 are one client's, 21 another's.
-  std::atomic<bool> in_hand{false};
-  std::promise<void> gate;
-  std::shared_future<void> opened = gate.get_future().share();
-  QueuedWorker<int> worker("grouped",
-                           [&](int item) {
-                             if (item != 11) return;
-                             in_hand = true;
-                             opened.wait();
-                           },
-                           {.capacity = 0,
-                            .newest_first = false,
-                            .thread_nice = 0,
-                            .on_failure = {},
-                            .group = [](const int& item) -> std::uint64_t {
-                              return static_cast<std::uint64_t>(item / 10);
-                            },
-                            .backlog = 3});
-  worker.push(11);
-  worker.start();
-  ASSERT_TRUE(becomesTrue(in_hand));
-  worker.push(21);
-  EXPECT_FALSE(worker.giveWay()->load());
-  EXPECT_TRUE(worker.hasQueuedOfGroup(21));
-  EXPECT_FALSE(worker.hasQueuedOfGroup(11));
-  worker.push(12);
-  EXPECT_TRUE(worker.giveWay()->load());
-  EXPECT_TRUE(worker.hasQueuedOfGroup(11));
-  gate.set_value();
-  worker.waitUntilIdle();
+  HeldItem held(true);
+  ASSERT_TRUE(held.inHand());
+  held.worker().push(21);
+  EXPECT_FALSE(held.givesWay());
+  EXPECT_TRUE(held.worker().hasQueuedOfGroup(21));
+  EXPECT_FALSE(held.worker().hasQueuedOfGroup(11));
+  held.worker().push(12);
+  EXPECT_TRUE(held.givesWay());
+  EXPECT_TRUE(held.worker().hasQueuedOfGroup(11));
 }
 
 TEST(QueuedWorker, ABacklogOfOtherGroupsMakesTheItemInHandGiveWay) {
-  std::atomic<bool> in_hand{false};
-  std::promise<void> gate;
-  std::shared_future<void> opened = gate.get_future().share();
-  QueuedWorker<int> worker("backlogged",
-                           [&](int item) {
-                             if (item != 11) return;
-                             in_hand = true;
-                             opened.wait();
-                           },
-                           {.capacity = 0,
-                            .newest_first = false,
-                            .thread_nice = 0,
-                            .on_failure = {},
-                            .group = [](const int& item) -> std::uint64_t {
-                              return static_cast<std::uint64_t>(item / 10);
-                            },
-                            .backlog = 3});
-  worker.push(11);
-  worker.start();
-  ASSERT_TRUE(becomesTrue(in_hand));
-  worker.push(21);
-  worker.push(31);
-  EXPECT_FALSE(worker.giveWay()->load());
-  worker.push(41);  // three waiting
-  EXPECT_TRUE(worker.giveWay()->load());
-  gate.set_value();
-  worker.waitUntilIdle();
+  HeldItem held(true);
+  ASSERT_TRUE(held.inHand());
+  held.worker().push(21);
+  held.worker().push(31);
+  EXPECT_FALSE(held.givesWay());
+  held.worker().push(41);  // three waiting
+  EXPECT_TRUE(held.givesWay());
 }
 
 TEST(QueuedWorker, WithoutGroupsEveryPushMakesTheItemInHandGiveWay) {
-  std::atomic<bool> in_hand{false};
-  std::promise<void> gate;
-  std::shared_future<void> opened = gate.get_future().share();
-  QueuedWorker<int> worker("ungrouped", [&](int item) {
-    if (item != 11) return;
-    in_hand = true;
-    opened.wait();
-  });
-  worker.push(11);
-  worker.start();
-  ASSERT_TRUE(becomesTrue(in_hand));
-  EXPECT_FALSE(worker.hasQueuedOfGroup(11));
-  worker.push(21);
-  EXPECT_TRUE(worker.giveWay()->load());
-  EXPECT_TRUE(worker.hasQueuedOfGroup(11));
-  gate.set_value();
-  worker.waitUntilIdle();
+  HeldItem held(false);
+  ASSERT_TRUE(held.inHand());
+  EXPECT_FALSE(held.worker().hasQueuedOfGroup(11));
+  held.worker().push(21);
+  EXPECT_TRUE(held.givesWay());
+  EXPECT_TRUE(held.worker().hasQueuedOfGroup(11));
 }
 
 TEST(QueuedWorker, AnExceptionEndsTheWorkerAlone) {
