@@ -3,12 +3,13 @@
 --runs times, min / median / max of the ATE, and the runs worse than 1.5x their cell's median named.
 
 Pacing: --fast (frames back to back, tracking waits for a back end that falls behind) and
---realtime (frames at the camera's rate). Modes: local (pinned to core 0) and edge (`edgeslam
-server` on core 1, `edgeslam client` on core 0, over loopback). KITTI rows add the KITTI odometry
+--realtime (frames at the camera's rate). Modes: local (pinned to core 0), edge (`edgeslam
+server` on core 1, `edgeslam client` on core 0, over loopback) and offload (the same, `client
+--mode offload`: the edge tracks every frame). KITTI rows add the KITTI odometry
 metric (t_rel %, r_rel deg/100 m; `edgeslam eval kitti`, Sim(3) aligned for monocular).
 
 Writes the table into docs/benchmarks.md between the PACING markers unless --no-docs. Usage:
-  bench/pacing_bench.py [--rows kitti03,mono,rgbd] [--modes local,edge] [--pacings fast,realtime]
+  bench/pacing_bench.py [--rows kitti03,mono,rgbd] [--modes local,edge,offload] [--pacings fast,realtime]
                         [--runs 5] [--max-frames N] [--keep DIR]
 """
 import argparse

@@ -1,7 +1,7 @@
-"""One `edgeslam` run for a bench: local mode (`run --mode local`), or edge mode (`client`) against
-an `edgeslam server` started for it on the server's core and stopped after; the client's command
-goes through `wrap` (pinning, a CPU quota). Returns metrics.json with `bench_wall_s` added, or
-None when the run failed (its log named on stderr)."""
+"""One `edgeslam` run for a bench: local mode (`run --mode local`), or edge or offload mode
+(`client`) against an `edgeslam server` started for it on the server's core and stopped after; the
+client's command goes through `wrap` (pinning, a CPU quota). Returns metrics.json with
+`bench_wall_s` added, or None when the run failed (its log named on stderr)."""
 import json
 import os
 import subprocess
@@ -22,7 +22,7 @@ def run_pinned(exe, mode, common, out_dir, wrap=pinned_to(CLIENT_CPU), server_ar
     server = None
     log = open(os.path.join(out_dir, log_name), "w")
     try:
-        if mode == "edge":
+        if mode in ("edge", "offload"):
             port = free_port()
             server = subprocess.Popen(
                 ["taskset", "-c", str(SERVER_CPU), exe, "server", "--listen", f"127.0.0.1:{port}",
@@ -30,6 +30,8 @@ def run_pinned(exe, mode, common, out_dir, wrap=pinned_to(CLIENT_CPU), server_ar
                 stdout=open(os.path.join(out_dir, "server.log"), "w"), stderr=subprocess.STDOUT)
             wait_for_port(port, server)
             cmd = [exe, "client", "--server", f"127.0.0.1:{port}"] + common
+            if mode == "offload":
+                cmd += ["--mode", "offload"]
         else:
             cmd = [exe, "run", "--mode", "local", "--maps", "none"] + common
         start = time.monotonic()

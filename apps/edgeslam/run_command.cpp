@@ -144,6 +144,7 @@ SessionConfig sessionConfig(const PinholeCamera& camera, Sensor sensor,
   config.settings.semantic = options.semantic;
   config.settings.client_map_keyframes = options.client_map_keyframes;
   config.settings.localize_only = options.localize_only;
+  config.settings.frames_back_to_back = slam_options.wait_for_backend;
   return config;
 }
 

@@ -164,7 +164,10 @@ void LoopCloser::processKeyFrame(KeyFrame* keyframe) {
 
 void LoopCloser::closeLoop(const VerifiedLoop& loop) {
   Stopwatch timer;
-  stopGlobalBundleAdjustment();  // its result would undo this correction
+  // A global BA under way would undo this correction. It is cancelled, not waited for: one solver
+  // iteration over a large map takes seconds, and its write-back checks the flag under the map
+  // mutex (loop_global_ba.cpp). The next launch joins it.
+  cancel_global_ba_ = true;
   if (mapper_ != nullptr) mapper_->pause();
   LoopCorrectionResult corrected;
   try {
@@ -237,6 +240,12 @@ void LoopCloser::launchGlobalBundleAdjustment(KeyFrameId loop_keyframe) {
     ++stats_.global_ba_started;
   }
   MutexLock lock(global_ba_mutex_);
+  if (global_ba_thread_.joinable()) {
+    Stopwatch wait;
+    global_ba_thread_.join();  // cancelled by the loop that launches this one
+    MutexLock stats_lock(stats_mutex_);
+    stats_.global_ba_handover_ms.add(wait.elapsedMs());
+  }
   cancel_global_ba_ = false;
   if (options_.threaded) {
     global_ba_thread_.start("global bundle adjustment", [this, loop_keyframe] {

@@ -77,6 +77,9 @@ struct LoopCloserStats {
   std::size_t global_ba_too_large = 0;  // the loop's part above global_ba_max_keyframes
   std::vector<LoopEvent> events;
   std::vector<double> global_ba_ms;  // solve and write-back of each applied run
+  // After a loop's correction, the wait for the global BA it cancelled to stop (on the loop
+  // thread, before the next BA starts; the correction itself does not wait).
+  SampleStats global_ba_handover_ms;
   // Per keyframe: describing it, querying the place database and verifying the candidates.
   SampleStats detection_ms;
 };

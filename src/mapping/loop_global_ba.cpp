@@ -124,6 +124,12 @@ LoopGlobalBundleAdjustmentResult runLoopGlobalBundleAdjustment(
     }
   } after_apply{hooks.after_apply};  // declared before the lock: runs once it is released
   MutexLock lock(map.updateMutex());
+  // A loop correction cancels this run without waiting for it and may have taken the lock first:
+  // the poses solved here would undo it.
+  if (cancel != nullptr && cancel->load()) {
+    result.cancelled = true;
+    return result;
+  }
   for (const std::size_t o : solved.outliers) {
     auto [kf, p] = owners[o];
     if (!kf->isBad() && !p->isBad()) {

@@ -14,7 +14,7 @@ void PacedKeyFrameSink::waitFor(const std::function<void()>& wait) {
   Stopwatch waited;
   wait();
   const double ms = waited.elapsedMs();
-  if (ms >= kWaitedMs) {
+  if (ms >= kBackendWaitedMs) {
     MutexLock lock(mutex_);
     waits_ms_.add(ms);
     wait_total_ms_ += ms;
@@ -25,6 +25,11 @@ bool PacedKeyFrameSink::acceptsKeyFrames() const {
   const bool accepts = inner_.acceptsKeyFrames();
   if (!accepts) ++busy_refusals_;
   return accepts;
+}
+
+double PacedKeyFrameSink::waitTotalMs() const {
+  MutexLock lock(mutex_);
+  return wait_total_ms_;
 }
 
 BackendPacing PacedKeyFrameSink::pacing() const {

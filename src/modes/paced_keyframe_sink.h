@@ -19,6 +19,9 @@
 
 namespace edgeslam {
 
+// A wait this short found the back end idle already (a lock taken and released): not counted.
+inline constexpr double kBackendWaitedMs = 0.1;
+
 struct BackendPacing {
   std::uint64_t waits = 0;          // keyframes that waited for the back end
   double wait_total_ms = 0.0;       // tracking's time spent waiting, all keyframes
@@ -40,13 +43,11 @@ class PacedKeyFrameSink : public KeyFrameSink {
   void onMapReset() override { inner_.onMapReset(); }
 
   BackendPacing pacing() const;
+  double waitTotalMs() const;
   // Another wait of tracking for the back end (counted with the keyframes' own).
   void waitFor(const std::function<void()>& wait);
 
  private:
-  // A wait this short found the back end idle already (a lock taken and released).
-  static constexpr double kWaitedMs = 0.1;
-
   KeyFrameSink& inner_;
   std::function<void()> wait_until_idle_;
   mutable Mutex mutex_;

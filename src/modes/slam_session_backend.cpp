@@ -368,10 +368,14 @@ std::optional<OffloadResult> SlamSessionBackend::onFrame(OffloadFrame frame) {
     // Each frame's pose goes back as it is tracked; nothing would carry an end-of-session
     // refinement to the client.
     slam_options.refine_intrinsics = false;
+    // Recorded frames fed back to back: the same offline pacing as local mode's.
+    slam_options.wait_for_backend = config_.settings.frames_back_to_back;
     offload_ = std::make_unique<LocalSlam>(config_.camera, slam_options);
   }
+  const double waited_before_ms = offload_->backendWaitTotalMs();
   const TrackResult tracked = offload_->process(frame.frame_index, frame.timestamp, gray, depth);
   OffloadResult result;
+  result.backend_wait_ms = offload_->backendWaitTotalMs() - waited_before_ms;
   result.frame_index = frame.frame_index;
   result.state = toOffloadState(tracked.state);
   result.T_cw = tracked.T_cw;
@@ -410,6 +414,7 @@ BackendCosts SlamSessionBackend::costs() const {
     SampleStats global_ba;
     for (const double ms : loops.global_ba_ms) global_ba.add(ms);
     costs.stages_ms.emplace_back("global_ba", global_ba.summary());
+    costs.stages_ms.emplace_back("global_ba_handover", loops.global_ba_handover_ms.summary());
   }
   return costs;
 }

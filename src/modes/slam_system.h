@@ -210,6 +210,8 @@ class TrackingSlam : public SlamSystem {
   }
 
   const Tracker& tracker() const { return *tracker_; }
+  // Tracking's time spent waiting for the back end so far (offline pacing; 0 without it).
+  double backendWaitTotalMs() const { return paced_sink_ ? paced_sink_->waitTotalMs() : 0.0; }
   // The client's map (lock its update mutex while reading it during a run).
   const Map& map() const { return map_; }
 

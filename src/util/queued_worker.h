@@ -114,17 +114,20 @@ class QueuedWorker {
     });
   }
 
-  // The thread takes no item until resume(); returns once the item in hand (if any) is done.
+  // The thread takes no item until every pause() has had its resume() (two threads may each hold
+  // the worker paused, e.g. a loop correction and a global BA's write-back); returns once the item
+  // in hand (if any) is done.
   void pause() {
     MutexLock lock(mutex_);
-    paused_ = true;
+    ++pauses_;
     give_way_ = true;
     lock.wait(idle_, [this]() REQUIRES(mutex_) { return !busy_; });
   }
   void resume() {
     {
       MutexLock lock(mutex_);
-      paused_ = false;
+      if (pauses_ > 0) --pauses_;
+      if (pauses_ > 0) return;
     }
     wake_.notify_all();
   }
@@ -177,7 +180,7 @@ class QueuedWorker {
         busy_ = false;
         idle_.notify_all();
         lock.wait(wake_,
-                  [this]() REQUIRES(mutex_) { return stopping_ || (!paused_ && !queue_.empty()); });
+                  [this]() REQUIRES(mutex_) { return stopping_ || (pauses_ == 0 && !queue_.empty()); });
         if (stopping_) return;
         item.emplace(popNext());
         busy_ = true;
@@ -234,7 +237,7 @@ class QueuedWorker {
   std::size_t dropped_ GUARDED_BY(mutex_) = 0;
   bool started_ GUARDED_BY(mutex_) = false;
   bool busy_ GUARDED_BY(mutex_) = false;
-  bool paused_ GUARDED_BY(mutex_) = false;
+  int pauses_ GUARDED_BY(mutex_) = 0;
   bool stopping_ GUARDED_BY(mutex_) = false;
   bool failed_ GUARDED_BY(mutex_) = false;
   std::optional<std::uint64_t> group_in_hand_ GUARDED_BY(mutex_);  // the last item taken's

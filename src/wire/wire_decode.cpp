@@ -647,7 +647,8 @@ SessionConfig fromProto(const v1::OpenSessionRequest& in) {
                     s.scale_factor(),
                     s.semantic(),
                     static_cast<int>(s.client_map_keyframes()),
-                    s.localize_only()};
+                    s.localize_only(),
+                    s.frames_back_to_back()};
     if (in.preferred_id_origin() > 255) {
       throw WireError(fmt::format("preferred_id_origin {} exceeds 255", in.preferred_id_origin()));
     }
@@ -703,6 +704,11 @@ OffloadResult fromProto(const v1::OffloadFrameReply& in) {
     }
     requireFinite(in.server_ms(), "server_ms");
     out.server_ms = in.server_ms();
+    requireFinite(in.backend_wait_ms(), "backend_wait_ms");
+    if (in.backend_wait_ms() < 0.0) {
+      throw WireError(fmt::format("backend_wait_ms {} is negative", in.backend_wait_ms()));
+    }
+    out.backend_wait_ms = in.backend_wait_ms();
     return out;
   });
 }

@@ -489,6 +489,7 @@ void toProto(const SessionConfig& config, v1::OpenSessionRequest* out) {
   settings->set_client_map_keyframes(
       static_cast<std::uint32_t>(std::max(config.settings.client_map_keyframes, 0)));
   settings->set_localize_only(config.settings.localize_only);
+  settings->set_frames_back_to_back(config.settings.frames_back_to_back);
   out->set_preferred_id_origin(config.id_origin);
 }
 
@@ -516,6 +517,7 @@ void toProto(const OffloadResult& result, v1::OffloadFrameReply* out) {
   }
   if (result.T_cw) toProto(*result.T_cw, out->mutable_t_cw());
   out->set_server_ms(result.server_ms);
+  out->set_backend_wait_ms(result.backend_wait_ms);
 }
 
 std::size_t wireSize(const google::protobuf::MessageLite& message) {

@@ -24,6 +24,8 @@ struct SessionSettings {
   int client_map_keyframes = 0;
   // Localise in the stored map named by SessionConfig::map_name, changing nothing in it.
   bool localize_only = false;
+  // Offload mode: recorded frames fed back to back; the edge paces its tracking by its back end.
+  bool frames_back_to_back = false;
 };
 
 // What a client opens a session with; id_origin and session_id are filled in by the server.
@@ -54,6 +56,7 @@ struct OffloadResult {
   OffloadTrackingState state = OffloadTrackingState::kNotInitialized;
   std::optional<SE3d> T_cw;  // camera-from-world when tracked
   double server_ms = 0.0;    // time the edge spent on the frame
+  double backend_wait_ms = 0.0;  // of it, its tracking's wait for its back end (paced offline)
 };
 
 }  // namespace edgeslam

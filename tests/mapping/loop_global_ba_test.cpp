@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <atomic>
 #include <vector>
 
 #include "corridor_map.h"
@@ -62,6 +63,38 @@ TEST(LoopGlobalBundleAdjustment, APartAboveTheBoundIsNotAdjusted) {
       m.corridor.map, m.corridor.camera, nullptr, 3, {}, m.second.front(), 7);
   EXPECT_FALSE(small.too_large);
   EXPECT_EQ(small.keyframes, 3u);
+}
+
+// A loop correction cancels a global BA without waiting for its solve; when the cancellation comes
+// after the solve, while the run waits for the map (the correction holds it), nothing is written.
+TEST(LoopGlobalBundleAdjustment, ARunCancelledBeforeItsWriteBackChangesNothing) {
+  for (const bool cancelled_meanwhile : {false, true}) {
+    TwoCorridors m;
+    std::vector<Eigen::Vector3d> before;
+    {
+      MutexLock lock(m.corridor.map.updateMutex());
+      for (int i = 1000; i < 1060; ++i) before.push_back(m.corridor.point(i)->position());
+    }
+    std::atomic<bool> cancel{false};
+    GlobalBundleAdjustmentHooks hooks;
+    hooks.before_apply = [&] { cancel = cancelled_meanwhile; };
+    const LoopGlobalBundleAdjustmentResult result = runLoopGlobalBundleAdjustment(
+        m.corridor.map, m.corridor.camera, &cancel, 5, hooks, m.second.front(), 0);
+    EXPECT_EQ(result.cancelled, cancelled_meanwhile);
+    EXPECT_EQ(result.applied, !cancelled_meanwhile);
+    MutexLock lock(m.corridor.map.updateMutex());
+    std::size_t moved = 0;
+    for (int i = 1000; i < 1060; ++i) {
+      const MapPoint* p = m.corridor.point(i);
+      if (p == nullptr || !p->position().isApprox(before[static_cast<std::size_t>(i - 1000)], 0.0))
+        ++moved;
+    }
+    if (cancelled_meanwhile) {
+      EXPECT_EQ(moved, 0u) << "a cancelled run wrote its solution";
+    } else {
+      EXPECT_GT(moved, 0u) << "the run that was not cancelled moved nothing";
+    }
+  }
 }
 
 }  // namespace

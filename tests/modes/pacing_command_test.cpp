@@ -87,6 +87,27 @@ TEST(Pacing, RealtimeEdgeMonocularRunOnKittiTracksTheDrive) {
   EXPECT_LT(last_rows, 0.1 * frames) << metrics["adapt"].dump();
 }
 
+// Offload mode fed back to back: the client sends every frame and waits for its pose, so the
+// edge's tracking outran its own mapper as local mode's once did. The session is told the frames
+// come back to back (SessionSettings.frames_back_to_back) and its tracking waits for its back end
+// before each keyframe; the waits come back with the poses and are counted in metrics.json.
+TEST(Pacing, FastOffloadRunWaitsForTheEdgesBackEnd) {
+  EDGESLAM_REQUIRE_SHARED("datasets/kitti03-400");
+  const auto out = freshDir("kitti03_offload_fast");
+  const auto r = test::runEdgeslam(
+      "run --dataset " + test::sharedPath("datasets/kitti03-400").string() +
+      " --mode offload --sensor mono --fast --max-frames 200 --maps none --out " + out.string());
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto metrics = readMetrics(out);
+  EXPECT_EQ(metrics["pacing"], "fast");
+  EXPECT_GE(metrics["tracked"].get<int>(), 190) << r.output;
+  EXPECT_LT(metrics["ate_final"]["rmse_m"].get<double>(), 1.0);
+  EXPECT_GT(metrics["backend_waits"].get<int>(), 0);
+  EXPECT_GT(metrics["backend_wait_ms"]["total"].get<double>(), 0.0);
+  EXPECT_GE(metrics["backend_wait_ms"]["max"].get<double>(),
+            metrics["backend_wait_ms"]["median"].get<double>());
+}
+
 // `--deterministic` (for tests and bisecting): the back end in lock-step with tracking, one
 // thread, so two runs write the same trajectories byte for byte, monocular and RGB-D.
 TEST(Pacing, DeterministicRunsAreIdentical) {

@@ -173,6 +173,23 @@ TEST(QueuedWorker, PauseHoldsItemsUntilResume) {
   EXPECT_EQ(record.seen(), std::vector<int>{7});
 }
 
+// A loop correction and a global BA's write-back may each hold the local mapper paused at once:
+// the first resume must not let the worker go while the other still holds it.
+TEST(QueuedWorker, PausesAreCountedUntilEachIsResumed) {
+  Record record;
+  QueuedWorker<int> worker("paused twice", [&](int item) { record.add(item); });
+  worker.start();
+  worker.pause();
+  worker.pause();
+  worker.push(7);
+  worker.resume();
+  std::this_thread::sleep_for(100ms);
+  EXPECT_TRUE(record.seen().empty()) << "one pause was still held";
+  worker.resume();
+  worker.waitUntilIdle();
+  EXPECT_EQ(record.seen(), std::vector<int>{7});
+}
+
 TEST(QueuedWorker, PauseWaitsForTheItemInHandAndAsksItToGiveWay) {
   std::atomic<bool> in_hand{false};
   std::atomic<bool> gave_way{false};

@@ -455,6 +455,15 @@ TEST(WireConvert, LocalisationQueryAndAnswerRoundTrip) {
   EXPECT_TRUE(fromProto(request).settings.localize_only);
   request.mutable_settings()->clear_localize_only();
   EXPECT_FALSE(fromProto(request).settings.localize_only);
+
+  // Offload pacing: a client that feeds recorded frames back to back says so; an older client
+  // does not send the field and is taken as paced by a camera.
+  config.settings.frames_back_to_back = true;
+  request.Clear();
+  toProto(config, &request);
+  EXPECT_TRUE(fromProto(request).settings.frames_back_to_back);
+  request.mutable_settings()->clear_frames_back_to_back();
+  EXPECT_FALSE(fromProto(request).settings.frames_back_to_back);
 }
 
 TEST(WireConvert, SessionConfigRoundTrip) {
