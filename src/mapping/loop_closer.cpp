@@ -169,6 +169,7 @@ void LoopCloser::closeLoop(const VerifiedLoop& loop) {
   // mutex (loop_global_ba.cpp). The next launch joins it.
   cancel_global_ba_ = true;
   if (mapper_ != nullptr) mapper_->pause();
+  const double pause_ms = timer.elapsedMs();
   LoopCorrectionResult corrected;
   try {
     corrected = correctLoop(map_, loop, camera_, options_.correction, on_merged_);
@@ -212,11 +213,12 @@ void LoopCloser::closeLoop(const VerifiedLoop& loop) {
       "loop closed: keyframe {} (frame {}) -> keyframe {} (frame {}): {} Sim3 inliers, {} points "
       "matched, scale {:.3f}, moved {:.3f} m / {:.2f} deg; {} keyframes corrected with it, {} "
       "points fused, {} new links; essential graph {} vertices {} edges {:.1f} ms; {:.1f} ms in "
-      "all",
+      "all (local mapping paused in {:.1f} ms, graph built in {:.1f} ms, applied in {:.1f} ms)",
       event.current, event.current_frame, event.loop, event.loop_frame, event.sim3_inliers,
       event.matched_points, event.scale, event.translation_m, event.rotation_deg,
       corrected.neighbourhood, corrected.points_replaced, corrected.new_links,
-      corrected.graph_vertices, corrected.graph_edges, corrected.pose_graph_ms, elapsed_ms);
+      corrected.graph_vertices, corrected.graph_edges, corrected.pose_graph_ms, elapsed_ms,
+      pause_ms, corrected.prepare_ms, corrected.apply_ms);
   {
     MutexLock lock(stats_mutex_);
     stats_.events.push_back(event);

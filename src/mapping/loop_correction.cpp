@@ -2,7 +2,9 @@
 
 #include <cmath>
 #include <set>
+#include <algorithm>
 #include <unordered_map>
+#include <unordered_set>
 #include <utility>
 
 #include "map/map_matching.h"
@@ -30,6 +32,27 @@ struct GraphSnapshot {
   std::unordered_map<MapPoint*, KeyFrame*> point_anchor;
 };
 
+// The keyframes the essential graph joins to `seed` (spanning tree, loop edges, covisibility of
+// at least `min_weight`): what a correction can move. A part of the map joined to them by none
+// of those would be vertices without an edge to the loop, left where they are by the solve at
+// the cost of their own edges (a store of unconnected maps: nearly all of the work). Sorted by id.
+std::vector<KeyFrame*> essentialGraphPart(KeyFrame* seed, int min_weight) {
+  std::vector<KeyFrame*> part{seed};
+  std::unordered_set<const KeyFrame*> seen{seed};
+  const auto visit = [&](KeyFrame* kf) {
+    if (kf != nullptr && !kf->isBad() && seen.insert(kf).second) part.push_back(kf);
+  };
+  for (std::size_t next = 0; next < part.size(); ++next) {
+    const KeyFrame* kf = part[next];
+    visit(kf->parent());
+    for (KeyFrame* child : kf->children()) visit(child);
+    for (KeyFrame* other : kf->loopEdges()) visit(other);
+    for (KeyFrame* other : kf->covisiblesWithWeightAtLeast(min_weight)) visit(other);
+  }
+  std::sort(part.begin(), part.end(), KeyFrameIdLess{});
+  return part;
+}
+
 }  // namespace
 
 LoopCorrectionResult correctLoop(Map& map, const VerifiedLoop& verified,
@@ -41,6 +64,7 @@ LoopCorrectionResult correctLoop(Map& map, const VerifiedLoop& verified,
   KeyFrame* loop_kf = loop.loop;
   GraphSnapshot snapshot;
   SE3d current_before;
+  Stopwatch prepare_timer;
   {
     MutexLock lock(map.updateMutex());
     if (current->isBad() || loop_kf->isBad()) return result;
@@ -118,10 +142,10 @@ LoopCorrectionResult correctLoop(Map& map, const VerifiedLoop& verified,
     }
     map.addLoopEdge(current, loop_kf);
 
-    // 4. The essential graph over every keyframe. New links state the corrected relation; all
-    //    other constraints keep the relative poses the map had before the loop.
+    // 4. The essential graph over the keyframes it joins to the loop. New links state the
+    //    corrected relation; all other constraints keep the relative poses the map had before.
     std::unordered_map<const KeyFrame*, std::size_t> vertex_of;
-    for (KeyFrame* kf : map.keyFrames()) {
+    for (KeyFrame* kf : essentialGraphPart(loop_kf, options.min_covisibility_weight)) {
       vertex_of.emplace(kf, snapshot.vertex_keyframes.size());
       snapshot.vertex_keyframes.push_back(kf);
       const auto c = corrected.find(kf);
@@ -165,6 +189,7 @@ LoopCorrectionResult correctLoop(Map& map, const VerifiedLoop& verified,
     }
     result.neighbourhood = neighbourhood.size();
   }
+  result.prepare_ms = prepare_timer.elapsedMs();
 
   // 5. Solve without the lock (mapping is paused by the caller; tracking goes on).
   result.graph_vertices = snapshot.graph.vertices.size();
@@ -176,6 +201,7 @@ LoopCorrectionResult correctLoop(Map& map, const VerifiedLoop& verified,
   const PoseGraphResult solved = optimizePoseGraph(snapshot.graph, graph_options);
   result.pose_graph_ms = timer.elapsedMs();
 
+  Stopwatch apply_timer;
   MutexLock lock(map.updateMutex());
   MapCorrection correction;
   for (std::size_t v = 0; v < snapshot.vertex_keyframes.size(); ++v) {
@@ -185,6 +211,7 @@ LoopCorrectionResult correctLoop(Map& map, const VerifiedLoop& verified,
   }
   correction.point_anchor = std::move(snapshot.point_anchor);
   applyMapCorrection(map, correction);
+  result.apply_ms = apply_timer.elapsedMs();
 
   const SE3d change = current->pose() * current_before.inverse();
   result.translation_m = (current->cameraCenter() - current_before.inverse().translation()).norm();

@@ -34,6 +34,10 @@ struct LoopCorrectionResult {
   double rotation_deg = 0.0;
   double scale = 1.0;
   double pose_graph_ms = 0.0;
+  // The rest of the correction: the neighbourhood moved, points fused and the graph built (under
+  // the map mutex), and the solution applied to the map (under it again).
+  double prepare_ms = 0.0;
+  double apply_ms = 0.0;
   // A loop between two parts of the map that shared nothing (mergeSeparateParts): how much of
   // the map was moved onto the other part before the correction. 0 for an ordinary loop.
   std::size_t merged_keyframes_moved = 0;
