@@ -110,8 +110,8 @@ def main():
         if key not in ROWS:
             parser.error(f"unknown row {key!r}; known: {', '.join(ROWS)}")
     for mode in args.modes.split(","):
-        if mode not in ("local", "edge"):
-            parser.error(f"unknown mode {mode!r}; known: local, edge")
+        if mode not in ("local", "edge", "offload"):
+            parser.error(f"unknown mode {mode!r}; known: local, edge, offload")
     for pacing in args.pacings.split(","):
         if pacing not in ("fast", "realtime"):
             parser.error(f"unknown pacing {pacing!r}; known: fast, realtime")

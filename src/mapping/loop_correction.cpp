@@ -1,8 +1,8 @@
 #include "mapping/loop_correction.h"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
-#include <algorithm>
 #include <unordered_map>
 #include <unordered_set>
 #include <utility>

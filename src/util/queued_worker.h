@@ -179,8 +179,9 @@ class QueuedWorker {
         MutexLock lock(mutex_);
         busy_ = false;
         idle_.notify_all();
-        lock.wait(wake_,
-                  [this]() REQUIRES(mutex_) { return stopping_ || (pauses_ == 0 && !queue_.empty()); });
+        lock.wait(wake_, [this]() REQUIRES(mutex_) {
+          return stopping_ || (pauses_ == 0 && !queue_.empty());
+        });
         if (stopping_) return;
         item.emplace(popNext());
         busy_ = true;

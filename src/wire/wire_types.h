@@ -54,8 +54,8 @@ enum class OffloadTrackingState { kNotInitialized, kOk, kLost };
 struct OffloadResult {
   std::uint64_t frame_index = 0;
   OffloadTrackingState state = OffloadTrackingState::kNotInitialized;
-  std::optional<SE3d> T_cw;  // camera-from-world when tracked
-  double server_ms = 0.0;    // time the edge spent on the frame
+  std::optional<SE3d> T_cw;      // camera-from-world when tracked
+  double server_ms = 0.0;        // time the edge spent on the frame
   double backend_wait_ms = 0.0;  // of it, its tracking's wait for its back end (paced offline)
 };
 

@@ -94,14 +94,16 @@ TEST(Pacing, RealtimeEdgeMonocularRunOnKittiTracksTheDrive) {
 TEST(Pacing, FastOffloadRunWaitsForTheEdgesBackEnd) {
   EDGESLAM_REQUIRE_SHARED("datasets/kitti03-400");
   const auto out = freshDir("kitti03_offload_fast");
-  const auto r = test::runEdgeslam(
-      "run --dataset " + test::sharedPath("datasets/kitti03-400").string() +
-      " --mode offload --sensor mono --fast --max-frames 200 --maps none --out " + out.string());
+  const auto r =
+      test::runEdgeslam("run --dataset " + test::sharedPath("datasets/kitti03-400").string() +
+                        " --mode offload --sensor mono --fast --maps none --out " + out.string());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto metrics = readMetrics(out);
   EXPECT_EQ(metrics["pacing"], "fast");
-  EXPECT_GE(metrics["tracked"].get<int>(), 190) << r.output;
-  EXPECT_LT(metrics["ate_final"]["rmse_m"].get<double>(), 1.0);
+  EXPECT_GE(metrics["tracked"].get<int>(), 390) << r.output;
+  // 0.818 [0.795-1.028] m fed back to back, 0.807 [0.795-0.975] at the camera's pace (3 runs
+  // each, docs/benchmarks.md, Accuracy against pacing).
+  EXPECT_LT(metrics["ate_final"]["rmse_m"].get<double>(), 1.3);
   EXPECT_GT(metrics["backend_waits"].get<int>(), 0);
   EXPECT_GT(metrics["backend_wait_ms"]["total"].get<double>(), 0.0);
   EXPECT_GE(metrics["backend_wait_ms"]["max"].get<double>(),
