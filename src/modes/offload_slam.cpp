@@ -34,10 +34,7 @@ TrackResult OffloadSlam::process(std::size_t frame_index, double timestamp, cons
     return result;
   }
   server_ms_.add(answer->server_ms);
-  if (answer->backend_wait_ms >= kBackendWaitedMs) {
-    backend_waits_ms_.add(answer->backend_wait_ms);
-    backend_wait_total_ms_ += answer->backend_wait_ms;
-  }
+  backend_waits_.add(answer->backend_wait_ms);
   switch (answer->state) {
     case OffloadTrackingState::kOk:
       result.state = TrackingState::kOk;
@@ -67,9 +64,7 @@ SlamCounters OffloadSlam::counters() const {
   out.exchange.downlink_bytes = c.downlink_bytes;
   out.exchange.reconnects = c.reconnects;
   out.exchange.edge_frame_ms = server_ms_.summary();
-  out.backend.waits = backend_waits_ms_.count();
-  out.backend.wait_total_ms = backend_wait_total_ms_;
-  out.backend.wait_ms = backend_waits_ms_.summary();
+  out.backend = backend_waits_.pacing();
   return out;
 }
 

@@ -41,9 +41,7 @@ class OffloadSlam : public SlamSystem {
   Trajectory poses_;
   std::vector<int> encode_params_;
   SampleStats server_ms_;
-  // The edge's waits for its back end (frames fed back to back), as local mode counts its own.
-  SampleStats backend_waits_ms_;
-  double backend_wait_total_ms_ = 0.0;
+  BackendWaits backend_waits_;  // the edge's, reported with each pose (frames fed back to back)
 };
 
 }  // namespace edgeslam

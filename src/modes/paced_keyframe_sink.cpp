@@ -14,11 +14,8 @@ void PacedKeyFrameSink::waitFor(const std::function<void()>& wait) {
   Stopwatch waited;
   wait();
   const double ms = waited.elapsedMs();
-  if (ms >= kBackendWaitedMs) {
-    MutexLock lock(mutex_);
-    waits_ms_.add(ms);
-    wait_total_ms_ += ms;
-  }
+  MutexLock lock(mutex_);
+  waits_.add(ms);
 }
 
 bool PacedKeyFrameSink::acceptsKeyFrames() const {
@@ -29,12 +26,12 @@ bool PacedKeyFrameSink::acceptsKeyFrames() const {
 
 double PacedKeyFrameSink::waitTotalMs() const {
   MutexLock lock(mutex_);
-  return wait_total_ms_;
+  return waits_.totalMs();
 }
 
 BackendPacing PacedKeyFrameSink::pacing() const {
   MutexLock lock(mutex_);
-  return {waits_ms_.count(), wait_total_ms_, waits_ms_.summary(), busy_refusals_.load()};
+  return waits_.pacing(busy_refusals_.load());
 }
 
 }  // namespace edgeslam

@@ -19,14 +19,33 @@
 
 namespace edgeslam {
 
-// A wait this short found the back end idle already (a lock taken and released): not counted.
-inline constexpr double kBackendWaitedMs = 0.1;
-
 struct BackendPacing {
   std::uint64_t waits = 0;          // keyframes that waited for the back end
   double wait_total_ms = 0.0;       // tracking's time spent waiting, all keyframes
   PercentileSummary wait_ms;        // per wait
   std::uint64_t busy_refusals = 0;  // decisions at which the back end could take no keyframe
+};
+
+// Tracking's waits for its back end, counted the same wherever tracking runs (here, and for
+// offload mode on the client from the waits the edge reports). Not synchronised.
+class BackendWaits {
+ public:
+  // A wait this short found the back end idle already (a lock taken and released): not counted.
+  static constexpr double kWaitedMs = 0.1;
+
+  void add(double ms) {
+    if (ms < kWaitedMs) return;
+    waits_ms_.add(ms);
+    total_ms_ += ms;
+  }
+  double totalMs() const { return total_ms_; }
+  BackendPacing pacing(std::uint64_t busy_refusals = 0) const {
+    return {waits_ms_.count(), total_ms_, waits_ms_.summary(), busy_refusals};
+  }
+
+ private:
+  SampleStats waits_ms_;
+  double total_ms_ = 0.0;
 };
 
 class PacedKeyFrameSink : public KeyFrameSink {
@@ -51,8 +70,7 @@ class PacedKeyFrameSink : public KeyFrameSink {
   KeyFrameSink& inner_;
   std::function<void()> wait_until_idle_;
   mutable Mutex mutex_;
-  SampleStats waits_ms_ GUARDED_BY(mutex_);
-  double wait_total_ms_ GUARDED_BY(mutex_) = 0.0;
+  BackendWaits waits_ GUARDED_BY(mutex_);
   mutable std::atomic<std::uint64_t> busy_refusals_{0};
 };
 

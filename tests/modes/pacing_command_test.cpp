@@ -31,17 +31,31 @@ nlohmann::json readMetrics(const std::filesystem::path& out) {
   return nlohmann::json::parse(in);
 }
 
+struct KittiRun {
+  int exit_code = 0;
+  std::string output;
+  nlohmann::json metrics;  // when it exited 0
+};
+
+// A monocular `run` over KITTI 03's first 400 frames with `args` (mode, pacing, store).
+KittiRun runOnKitti03(const std::string& name, const std::string& args) {
+  const auto out = freshDir(name);
+  const auto r =
+      test::runEdgeslam("run --dataset " + test::sharedPath("datasets/kitti03-400").string() +
+                        " --sensor mono " + args + " --out " + out.string());
+  KittiRun run{r.exit_code, r.output, {}};
+  if (r.exit_code == 0) run.metrics = readMetrics(out);
+  return run;
+}
+
 // KITTI 03's first 400 frames, monocular, local mode: before the back end set the pace, a mapper
 // that fell behind let the map's scale shrink along the drive (issue 24: ATE 2.92 m fed back to
 // back against 0.71 m paced at the camera's rate).
 TEST(Pacing, FastLocalMonocularRunOnKittiKeepsTheCameraPacedAccuracy) {
   EDGESLAM_REQUIRE_SHARED("datasets/kitti03-400");
-  const auto out = freshDir("kitti03_fast");
-  const auto r =
-      test::runEdgeslam("run --dataset " + test::sharedPath("datasets/kitti03-400").string() +
-                        " --mode local --sensor mono --fast --out " + out.string());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  const auto metrics = readMetrics(out);
+  const KittiRun run = runOnKitti03("kitti03_fast", "--mode local --fast");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const auto& metrics = run.metrics;
   EXPECT_EQ(metrics["pacing"], "fast");
   EXPECT_GE(metrics["tracked"].get<int>(), 390);
   // With the wait: 0.83 and 0.99 m on a saturated host (docs/benchmarks.md, Pacing).
@@ -68,14 +82,11 @@ TEST(Pacing, FastLocalMonocularRunOnKittiKeepsTheCameraPacedAccuracy) {
 // regained, in 2 of 3 runs.
 TEST(Pacing, RealtimeEdgeMonocularRunOnKittiTracksTheDrive) {
   EDGESLAM_REQUIRE_SHARED("datasets/kitti03-400");
-  const auto out = freshDir("kitti03_edge_realtime");
-  const auto r =
-      test::runEdgeslam("run --dataset " + test::sharedPath("datasets/kitti03-400").string() +
-                        " --mode edge --sensor mono --realtime --maps none --out " + out.string());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  const auto metrics = readMetrics(out);
+  const KittiRun run = runOnKitti03("kitti03_edge_realtime", "--mode edge --realtime --maps none");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const auto& metrics = run.metrics;
   EXPECT_EQ(metrics["pacing"], "realtime");
-  EXPECT_GE(metrics["tracked"].get<int>(), 380) << r.output;
+  EXPECT_GE(metrics["tracked"].get<int>(), 380) << run.output;
   // 0.69-0.87 m over 285 m in 5 runs on a quiet host (ORB-SLAM's published monocular figure for
   // the whole of 03: 1.59 m over 561 m).
   EXPECT_LT(metrics["ate_final"]["rmse_m"].get<double>(), 1.3);
@@ -93,14 +104,11 @@ TEST(Pacing, RealtimeEdgeMonocularRunOnKittiTracksTheDrive) {
 // before each keyframe; the waits come back with the poses and are counted in metrics.json.
 TEST(Pacing, FastOffloadRunWaitsForTheEdgesBackEnd) {
   EDGESLAM_REQUIRE_SHARED("datasets/kitti03-400");
-  const auto out = freshDir("kitti03_offload_fast");
-  const auto r =
-      test::runEdgeslam("run --dataset " + test::sharedPath("datasets/kitti03-400").string() +
-                        " --mode offload --sensor mono --fast --maps none --out " + out.string());
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  const auto metrics = readMetrics(out);
+  const KittiRun run = runOnKitti03("kitti03_offload_fast", "--mode offload --fast --maps none");
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const auto& metrics = run.metrics;
   EXPECT_EQ(metrics["pacing"], "fast");
-  EXPECT_GE(metrics["tracked"].get<int>(), 390) << r.output;
+  EXPECT_GE(metrics["tracked"].get<int>(), 390) << run.output;
   // 0.818 [0.795-1.028] m fed back to back, 0.807 [0.795-0.975] at the camera's pace (3 runs
   // each, docs/benchmarks.md, Accuracy against pacing).
   EXPECT_LT(metrics["ate_final"]["rmse_m"].get<double>(), 1.3);
