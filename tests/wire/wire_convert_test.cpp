@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <limits>
 #include <numeric>
 #include <random>
 
@@ -513,7 +514,7 @@ TEST(WireConvert, OffloadRoundTrip) {
   EXPECT_EQ(back.depth_encoding, "png");
   EXPECT_EQ(back.depth_bytes, frame.depth_bytes);
 
-  const OffloadResult result{77, OffloadTrackingState::kOk, test::samplePose(rng), 3.5};
+  const OffloadResult result{77, OffloadTrackingState::kOk, test::samplePose(rng), 3.5, 1.25};
   v1::OffloadFrameReply reply;
   toProto(result, &reply);
   const OffloadResult result_back = fromProto(reply);
@@ -522,6 +523,14 @@ TEST(WireConvert, OffloadRoundTrip) {
   ASSERT_TRUE(result_back.T_cw.has_value());
   expectPoseNear(*result_back.T_cw, *result.T_cw);
   EXPECT_EQ(result_back.server_ms, 3.5);
+  EXPECT_EQ(result_back.backend_wait_ms, 1.25);
+  // A wait the edge could not have had is refused, not counted.
+  for (const double bad :
+       {-1.0, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+    v1::OffloadFrameReply damaged = reply;
+    damaged.set_backend_wait_ms(bad);
+    EXPECT_THROW(fromProto(damaged), WireError) << bad;
+  }
 
   v1::OffloadFrameReply lost;
   toProto(OffloadResult{78, OffloadTrackingState::kLost, std::nullopt, 1.0}, &lost);
